@@ -1,0 +1,38 @@
+// auvdock: the single command line of the project. Wiring only; the work is in the library.
+//
+// Exit status: 0 on success, 2 on bad input or a usage error (one line on stderr), 1 on an
+// unexpected internal error, 130 when interrupted.
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+
+#include "apps/commands.h"
+#include "auvdock/io/input_error.h"
+#include "auvdock/io/cancellation.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"auvdock: state estimation for the close-range phase of AUV recovery"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "auvdock 0.1.0");
+  auvdock::cli::AddSimulateCommand(app);
+  auvdock::cli::AddEvaluateCommand(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::fprintf(stderr, "auvdock: error: %s (see --help)\n", e.what());
+    return 2;
+  } catch (const auvdock::Cancelled& e) {
+    std::fprintf(stderr, "auvdock: interrupted: %s\n", e.what());
+    return 130;
+  } catch (const auvdock::InputError& e) {
+    std::fprintf(stderr, "auvdock: error: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "auvdock: internal error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,46 @@
+// The recovery platform ("dock") and its guide lights, in the dock frame D.
+//
+// Frame D: origin on the platform deck, x along the docking axis (the direction the vehicle
+// travels when it lands), y to starboard of that axis, z down. The deck is the plane z = 0
+// (lights sit on it, the vehicle is above it at z < 0). Gravity is a vector in D, nominally
+// (0, 0, +9.81) m/s^2; a tilted platform has a tilted gravity vector rather than a tilted D.
+// Units: metres, m/s^2.
+//
+// Layouts from the seeds: seed 004's T-shape (>= 3 non-collinear lights), seed 001's 8 lights on
+// the centre line over 2.8 m (degenerate for a 6-DoF pose: roll about the line is unobservable).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace auvdock {
+
+struct DockLight {
+  int id = 0;
+  Eigen::Vector3d p_D = Eigen::Vector3d::Zero();  // centre of the emitting surface
+  double radius_m = 0.05;                          // radius of the emitting disc
+  double intensity = 1.0;                          // relative radiant intensity (1 = nominal)
+};
+
+struct DockModel {
+  std::string name;
+  std::vector<DockLight> lights;
+  // Deck rectangle, centred on the D origin, used for rendering (the bright platform).
+  double deck_length_m = 3.0;  // along x
+  double deck_width_m = 2.0;   // along y
+  // Height of the deck above the surrounding seabed (the seabed is the plane z = deck_height_m).
+  double deck_height_m = 0.5;
+  Eigen::Vector3d gravity_D = Eigen::Vector3d(0.0, 0.0, 9.81);
+  // Water depth (m, below the surface) of the D origin; the pressure sensor measures depth.
+  double origin_depth_m = 30.0;
+  // Acoustic (USBL/SBL) beacon / transponder position on the platform.
+  Eigen::Vector3d p_D_beacon = Eigen::Vector3d::Zero();
+
+  // True when every light lies within tolerance_m of one line (pose about it unobservable).
+  bool LightsCollinear(double tolerance_m = 1e-3) const;
+  const DockLight* FindLight(int id) const;
+};
+
+}  // namespace auvdock

@@ -1,0 +1,46 @@
+// Writes a dataset folder in auvdock's layout (docs/dataset_format.md), sensor by sensor, as
+// the data is produced: every CSV row is flushed when added and every image is written when
+// added, so memory stays flat for long runs.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "auvdock/geometry/dock_model.h"
+#include "auvdock/io/calibration.h"
+#include "auvdock/io/csv.h"
+#include "auvdock/io/measurements.h"
+
+namespace auvdock {
+
+class DatasetWriter {
+ public:
+  // Writes calibration.yaml and dock.yaml into root (which must exist) and opens the sensor
+  // files of every sensor the calibration has.
+  DatasetWriter(const std::string& root, const Calibration& calibration, const DockModel& dock);
+
+  void AddImu(const ImuSample& s);
+  void AddDepth(const DepthMeasurement& m);
+  void AddDvl(const DvlMeasurement& m);
+  void AddAcoustic(const AcousticFix& m);
+  // Writes <camera>/data/<t_ns>.png (lossless, 8-bit) and its data.csv row.
+  void AddImage(const std::string& camera, int64_t t_ns, const cv::Mat& image);
+  void AddGroundTruth(const GroundTruthState& s);  // also appends to groundtruth.tum
+  void AddVisibility(const VisibilityRecord& r);
+  void AddFault(const FaultRecord& f);
+  void Close();
+
+  const std::string& root() const { return root_; }
+
+ private:
+  std::string root_;
+  int png_compression_ = 1;  // zlib level: fast; PNG stays lossless at every level
+  std::unique_ptr<CsvWriter> imu_, depth_, dvl_, acoustic_, groundtruth_, visibility_, faults_;
+  std::unique_ptr<CsvWriter> tum_;
+  std::map<std::string, std::unique_ptr<CsvWriter>> cameras_;
+};
+
+}  // namespace auvdock

@@ -1,0 +1,83 @@
+// Sensor records as stored in a dataset. Time is int64 nanoseconds; frames as named.
+//
+//   ImuSample         gyro w_B (rad/s) and specific force f_B (m/s^2) of the IMU, body frame B
+//                     (B is the IMU frame). f_B = R_B_D (a_D - g_D) + noise + bias.
+//   DepthMeasurement  depth below the surface (m) of the pressure sensor.
+//   DvlMeasurement    velocity of the DVL over the ground in the DVL frame S (m/s).
+//   AcousticFix       position of the vehicle's transducer in D (m) and its reported 1-sigma.
+//   CameraFrame       one image: timestamp and file path (absolute, or relative to the
+//                     camera folder's data/ directory as written in data.csv).
+//   GroundTruthState  EuRoC state ground truth: T_D_B, v_D (m/s), gyro and accel biases.
+//   VisibilityRecord  per camera frame: how many dock lights each camera truly sees and the
+//                     visibility stage of seed 000 (stereo only / both / mono only / neither).
+//   FaultRecord       a fault injected by the simulator on purpose (for evaluation).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "auvdock/geometry/pose3.h"
+
+namespace auvdock {
+
+struct ImuSample {
+  int64_t t_ns = 0;
+  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();   // rad/s
+  Eigen::Vector3d accel = Eigen::Vector3d::Zero();  // m/s^2 (specific force)
+};
+
+struct DepthMeasurement {
+  int64_t t_ns = 0;
+  double depth_m = 0.0;
+};
+
+struct DvlMeasurement {
+  int64_t t_ns = 0;
+  Eigen::Vector3d v_S = Eigen::Vector3d::Zero();
+};
+
+struct AcousticFix {
+  int64_t t_ns = 0;
+  Eigen::Vector3d p_D = Eigen::Vector3d::Zero();
+  double sigma_m = 0.0;
+};
+
+struct CameraFrame {
+  int64_t t_ns = 0;
+  std::string path;
+};
+
+struct GroundTruthState {
+  int64_t t_ns = 0;
+  Pose3 T_D_B;
+  Eigen::Vector3d v_D = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gyro_bias = Eigen::Vector3d::Zero();
+  Eigen::Vector3d accel_bias = Eigen::Vector3d::Zero();
+};
+
+// Seed 000's four visibility stages. A camera "sees" the dock when at least kMinLightsForPose
+// lights are in its image (for the stereo pair: in both images).
+enum class VisibilityStage { kStereoOnly, kBoth, kMonoOnly, kNeither, kUnknown };
+constexpr int kMinLightsForPose = 3;
+const char* VisibilityStageName(VisibilityStage stage);
+bool ParseVisibilityStage(const std::string& text, VisibilityStage* stage);
+VisibilityStage StageFromLightCounts(int n_stereo_left, int n_stereo_right, int n_mono);
+
+struct VisibilityRecord {
+  int64_t t_ns = 0;
+  int n_stereo_left = 0;
+  int n_stereo_right = 0;
+  int n_mono = 0;
+  VisibilityStage stage = VisibilityStage::kUnknown;
+};
+
+struct FaultRecord {
+  int64_t t_ns = 0;
+  std::string sensor;  // e.g. "dvl0", "usbl0", "cam2"
+  std::string kind;    // e.g. "gross_error", "outlier", "reflection", "particle"
+  std::string detail;  // free text without commas, e.g. "dv=0.41;0.02;-0.10"
+};
+
+}  // namespace auvdock

@@ -1,0 +1,45 @@
+// The CSV layouts of the dataset's sensor files, for reading and for writing, in one place
+// (docs/dataset_format.md). IMU, camera and ground-truth files use EuRoC's exact columns, so
+// the same readers serve auvdock datasets and real EuRoC sequences.
+//
+// Every reader checks that timestamps strictly increase and that numbers are finite; errors
+// name the file and line (InputError).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "auvdock/io/measurements.h"
+
+namespace auvdock {
+
+// Header lines (written verbatim; readers skip any line that starts with '#').
+extern const char kImuCsvHeader[];
+extern const char kCameraCsvHeader[];
+extern const char kDepthCsvHeader[];
+extern const char kDvlCsvHeader[];
+extern const char kAcousticCsvHeader[];
+extern const char kGroundTruthCsvHeader[];
+extern const char kVisibilityCsvHeader[];
+extern const char kFaultsCsvHeader[];
+
+std::vector<ImuSample> ReadImuCsv(const std::string& path);
+// Camera frames; each path is made absolute as <image_dir>/<filename>.
+std::vector<CameraFrame> ReadCameraCsv(const std::string& path, const std::string& image_dir);
+std::vector<DepthMeasurement> ReadDepthCsv(const std::string& path);
+std::vector<DvlMeasurement> ReadDvlCsv(const std::string& path);
+std::vector<AcousticFix> ReadAcousticCsv(const std::string& path);
+std::vector<GroundTruthState> ReadGroundTruthCsv(const std::string& path);
+std::vector<VisibilityRecord> ReadVisibilityCsv(const std::string& path);
+std::vector<FaultRecord> ReadFaultsCsv(const std::string& path);
+
+// One formatted row (without newline) of each file, matching the readers above.
+std::string ImuCsvRow(const ImuSample& s);
+std::string DepthCsvRow(const DepthMeasurement& m);
+std::string DvlCsvRow(const DvlMeasurement& m);
+std::string AcousticCsvRow(const AcousticFix& m);
+std::string GroundTruthCsvRow(const GroundTruthState& s);
+std::string VisibilityCsvRow(const VisibilityRecord& r);
+std::string FaultCsvRow(const FaultRecord& f);
+
+}  // namespace auvdock

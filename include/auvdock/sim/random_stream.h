@@ -1,0 +1,36 @@
+// Seeded, portable random numbers for the simulator.
+//
+// Each sensor draws from its own stream, derived from (seed, stream id) by SplitMix64, so
+// changing one sensor's settings does not change another sensor's noise, and the same seed gives
+// byte-identical output. The normal variates use our own Box-Muller transform on
+// std::mt19937_64 (whose output sequence the C++ standard fixes), not std::normal_distribution
+// (whose algorithm differs between standard libraries).
+#pragma once
+
+#include <cstdint>
+#include <random>
+
+#include <Eigen/Core>
+
+namespace auvdock {
+
+enum class RandomStreamId : uint64_t {
+  kImu = 1,
+  kDepth = 2,
+  kDvl = 3,
+  kAcoustic = 4,
+  kCameraBase = 100,  // + camera index
+};
+
+std::mt19937_64 MakeRandomStream(uint64_t seed, uint64_t stream_id);
+inline std::mt19937_64 MakeRandomStream(uint64_t seed, RandomStreamId id) {
+  return MakeRandomStream(seed, static_cast<uint64_t>(id));
+}
+
+// Uniform in [0, 1) with 53 random bits.
+double Uniform01(std::mt19937_64& rng);
+// Standard normal (Box-Muller).
+double StandardNormal(std::mt19937_64& rng);
+Eigen::Vector3d StandardNormal3(std::mt19937_64& rng);
+
+}  // namespace auvdock

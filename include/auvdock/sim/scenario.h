@@ -1,0 +1,69 @@
+// A simulation scenario (data/scenarios/*.yaml): the dock, the trajectory, the sensor rig and
+// its noise, the water and the faults to inject. Every key has a default (the defaults are the
+// built-in default scenario, with sensor figures from CONVENTIONS.md); unknown keys are errors.
+//
+// Frames: D dock (z down), B body = IMU (x forward, y right, z down), C camera (OpenCV).
+// The stereo pair looks forward and down (tilted by tilt_deg below the body x axis), the mono
+// camera straight down (image top towards the bow), as in seed 004's rig.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "auvdock/geometry/dock_model.h"
+#include "auvdock/io/calibration.h"
+#include "auvdock/sim/acoustic_simulator.h"
+#include "auvdock/sim/docking_trajectory.h"
+#include "auvdock/sim/dvl_simulator.h"
+#include "auvdock/sim/underwater_renderer.h"
+#include "auvdock/sim/water_model.h"
+
+namespace auvdock {
+
+struct CameraRigConfig {
+  int width = 640;
+  int height = 512;
+  double rate_hz = 10.0;
+  double hfov_deg = 70.0;
+  std::array<double, 5> distortion{-0.05, 0.01, 0.0005, -0.0003, 0.0};
+  double pixel_noise_px = 0.3;
+  double stereo_baseline_m = 0.25;
+  double stereo_tilt_deg = 40.0;                                  // below the body x axis
+  Eigen::Vector3d stereo_p_B = Eigen::Vector3d(0.9, 0.0, 0.2);    // midpoint of the pair
+  Eigen::Vector3d mono_p_B = Eigen::Vector3d(0.45, 0.0, 0.3);
+  bool render_images = true;
+};
+
+struct Scenario {
+  std::string name = "default";
+  std::string source_path;  // the YAML file it was read from ("" for built-in)
+  double duration_s = 40.0;
+  int64_t start_time_ns = 1700000000000000000;  // 2023-11-14T22:13:20Z, a realistic epoch
+  uint64_t seed = 1;
+  bool noise_enabled = true;  // false: every sensor exact (tests)
+
+  DockModel dock;
+  std::string dock_path;  // as written in the scenario (resolved relative to it)
+  DockingTrajectoryConfig trajectory;
+  CameraRigConfig cameras;
+  WaterType water_type = WaterType::kCoastal;
+  RenderOptions render;
+
+  ImuCalibration imu;
+  Eigen::Vector3d initial_gyro_bias = Eigen::Vector3d(0.002, -0.001, 0.0015);   // rad/s
+  Eigen::Vector3d initial_accel_bias = Eigen::Vector3d(0.03, -0.02, 0.04);      // m/s^2
+  DepthCalibration depth;
+  DvlCalibration dvl;
+  DvlFaultConfig dvl_faults;
+  AcousticCalibration acoustic;
+  AcousticFaultConfig acoustic_faults;
+};
+
+// Reads a scenario file; the dock file it names is read relative to the scenario's folder.
+// Throws InputError naming the file and key.
+Scenario LoadScenario(const std::string& path);
+
+// The calibration of the simulated rig (what the dataset's calibration.yaml holds).
+Calibration MakeCalibration(const Scenario& scenario);
+
+}  // namespace auvdock

@@ -1,0 +1,77 @@
+#include "auvdock/camera/pinhole_radtan_camera.h"
+
+#include <cassert>
+#include <cmath>
+
+#include <Eigen/Dense>
+
+namespace auvdock {
+
+PinholeRadtanCamera::PinholeRadtanCamera(int width, int height, double fx, double fy, double cx,
+                                         double cy, const std::array<double, 5>& distortion)
+    : width_(width), height_(height), fx_(fx), fy_(fy), cx_(cx), cy_(cy),
+      distortion_(distortion) {
+  assert(width > 0 && height > 0 && fx > 0 && fy > 0);
+}
+
+PinholeRadtanCamera PinholeRadtanCamera::FromHorizontalFov(
+    int width, int height, double hfov_rad, const std::array<double, 5>& distortion) {
+  const double f = 0.5 * width / std::tan(0.5 * hfov_rad);
+  return PinholeRadtanCamera(width, height, f, f, 0.5 * (width - 1), 0.5 * (height - 1),
+                             distortion);
+}
+
+Eigen::Matrix3d PinholeRadtanCamera::K() const {
+  Eigen::Matrix3d K;
+  K << fx_, 0.0, cx_, 0.0, fy_, cy_, 0.0, 0.0, 1.0;
+  return K;
+}
+
+std::optional<Eigen::Vector2d> PinholeRadtanCamera::Project(const Eigen::Vector3d& p_C,
+                                                            double min_depth) const {
+  if (!(p_C.z() > min_depth)) return std::nullopt;
+  return ProjectNormalized(p_C.head<2>() / p_C.z());
+}
+
+Eigen::Vector2d PinholeRadtanCamera::ProjectNormalized(const Eigen::Vector2d& xy) const {
+  double xd, yd;
+  DistortNormalized(distortion_, xy.x(), xy.y(), &xd, &yd);
+  return Eigen::Vector2d(fx_ * xd + cx_, fy_ * yd + cy_);
+}
+
+Eigen::Vector2d PinholeRadtanCamera::Unproject(const Eigen::Vector2d& uv) const {
+  const Eigen::Vector2d target((uv.x() - cx_) / fx_, (uv.y() - cy_) / fy_);
+  Eigen::Vector2d xy = target;  // distortion is mild: the distorted point is a good start
+  for (int iteration = 0; iteration < 20; ++iteration) {
+    // Residual and its 2x2 Jacobian by central differences (cheap, robust for any coefficient).
+    double xd, yd;
+    DistortNormalized(distortion_, xy.x(), xy.y(), &xd, &yd);
+    const Eigen::Vector2d r(xd - target.x(), yd - target.y());
+    if (r.squaredNorm() < 1e-26) break;
+    Eigen::Matrix2d J;
+    const double h = 1e-7;
+    for (int k = 0; k < 2; ++k) {
+      Eigen::Vector2d a = xy, b = xy;
+      a[k] += h;
+      b[k] -= h;
+      double xa, ya, xb, yb;
+      DistortNormalized(distortion_, a.x(), a.y(), &xa, &ya);
+      DistortNormalized(distortion_, b.x(), b.y(), &xb, &yb);
+      J.col(k) = Eigen::Vector2d(xa - xb, ya - yb) / (2.0 * h);
+    }
+    xy -= J.partialPivLu().solve(r);
+  }
+  return xy;
+}
+
+Eigen::Vector3d PinholeRadtanCamera::Bearing(const Eigen::Vector2d& uv) const {
+  const Eigen::Vector2d xy = Unproject(uv);
+  return Eigen::Vector3d(xy.x(), xy.y(), 1.0).normalized();
+}
+
+bool PinholeRadtanCamera::InImage(const Eigen::Vector2d& uv, double margin) const {
+  return uv.x() >= -0.5 + margin && uv.y() >= -0.5 + margin &&
+         uv.x() <= width_ - 0.5 - margin && uv.y() <= height_ - 0.5 - margin;
+}
+
+}  // namespace auvdock

@@ -1,0 +1,73 @@
+#include "auvdock/io/dataset.h"
+
+#include <filesystem>
+
+#include "auvdock/io/dock_io.h"
+#include "auvdock/io/input_error.h"
+#include "auvdock/io/sensor_csv.h"
+#include "euroc_dataset.h"
+
+namespace fs = std::filesystem;
+
+namespace auvdock {
+
+namespace {
+
+// The data.csv of a sensor folder, or "" when the sensor has no folder.
+std::string SensorCsv(const fs::path& root, const std::string& name) {
+  const fs::path p = root / name / "data.csv";
+  return fs::exists(p) ? p.string() : std::string();
+}
+
+Dataset LoadAuvdockDataset(const fs::path& root) {
+  Dataset ds;
+  ds.root = root.string();
+  ds.layout = DatasetLayout::kAuvdock;
+  ds.calibration = LoadCalibration((root / "calibration.yaml").string());
+  if (fs::exists(root / "dock.yaml")) ds.dock = LoadDockModel((root / "dock.yaml").string());
+
+  for (const auto& cam : ds.calibration.cameras) {
+    const std::string csv = SensorCsv(root, cam.name);
+    if (csv.empty()) throw InputError((root / cam.name / "data.csv").string() + ": missing");
+    ds.camera_frames[cam.name] = ReadCameraCsv(csv, (root / cam.name / "data").string());
+  }
+  if (ds.calibration.imu) {
+    const std::string csv = SensorCsv(root, ds.calibration.imu->name);
+    if (!csv.empty()) ds.imu = ReadImuCsv(csv);
+  }
+  if (ds.calibration.depth) {
+    const std::string csv = SensorCsv(root, ds.calibration.depth->name);
+    if (!csv.empty()) ds.depth = ReadDepthCsv(csv);
+  }
+  if (ds.calibration.dvl) {
+    const std::string csv = SensorCsv(root, ds.calibration.dvl->name);
+    if (!csv.empty()) ds.dvl = ReadDvlCsv(csv);
+  }
+  if (ds.calibration.acoustic) {
+    const std::string csv = SensorCsv(root, ds.calibration.acoustic->name);
+    if (!csv.empty()) ds.acoustic = ReadAcousticCsv(csv);
+  }
+  const fs::path gt = root / "groundtruth";
+  if (fs::exists(gt / "data.csv")) ds.groundtruth = ReadGroundTruthCsv((gt / "data.csv").string());
+  if (fs::exists(gt / "visibility.csv")) {
+    ds.visibility = ReadVisibilityCsv((gt / "visibility.csv").string());
+  }
+  if (fs::exists(gt / "faults.csv")) ds.faults = ReadFaultsCsv((gt / "faults.csv").string());
+  return ds;
+}
+
+}  // namespace
+
+Dataset LoadDataset(const std::string& dir) {
+  const fs::path root(dir);
+  std::error_code ec;
+  if (!fs::is_directory(root, ec)) throw InputError(dir + ": not a dataset folder");
+  if (fs::exists(root / "calibration.yaml")) return LoadAuvdockDataset(root);
+  if (fs::is_directory(root / "mav0")) return internal::LoadEurocDataset((root / "mav0").string());
+  if (fs::exists(root / "imu0" / "sensor.yaml") || fs::exists(root / "cam0" / "sensor.yaml")) {
+    return internal::LoadEurocDataset(root.string());
+  }
+  throw InputError(dir + ": not a dataset folder (no calibration.yaml, and no EuRoC mav0/)");
+}
+
+}  // namespace auvdock

@@ -1,0 +1,161 @@
+#include "auvdock/sim/docking_simulator.h"
+
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "auvdock/io/csv.h"
+#include "auvdock/io/dataset_writer.h"
+#include "auvdock/sim/acoustic_simulator.h"
+#include "auvdock/sim/depth_simulator.h"
+#include "auvdock/sim/dvl_simulator.h"
+#include "auvdock/sim/imu_simulator.h"
+#include "auvdock/sim/random_stream.h"
+
+namespace auvdock {
+
+DockingSimulator::DockingSimulator(const Scenario& scenario)
+    : scenario_(scenario), calibration_(MakeCalibration(scenario)),
+      trajectory_(scenario.trajectory) {
+  const WaterModel water = WaterModel::ForType(scenario.water_type);
+  RenderOptions render = scenario.render;
+  if (!scenario.noise_enabled) render.noise_sigma = 0.0;  // a noise-free run has clean images
+  for (const auto& cam : calibration_.cameras) {
+    renderers_.emplace_back(cam, scenario.dock, water, render);
+  }
+}
+
+int64_t DockingSimulator::SampleTime(int64_t k, double rate_hz) const {
+  return scenario_.start_time_ns + std::llround(static_cast<double>(k) * 1e9 / rate_hz);
+}
+
+double DockingSimulator::Seconds(int64_t t_ns) const {
+  return static_cast<double>(t_ns - scenario_.start_time_ns) * 1e-9;
+}
+
+Pose3 DockingSimulator::CameraPose(const CameraCalibration& camera, int64_t t_ns) const {
+  return trajectory_.At(Seconds(t_ns)).T_D_B * camera.T_B_C;
+}
+
+VisibilityRecord DockingSimulator::VisibilityAt(int64_t t_ns) const {
+  VisibilityRecord r;
+  r.t_ns = t_ns;
+  const Pose3 T_D_B = trajectory_.At(Seconds(t_ns)).T_D_B;
+  for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
+    const auto& cam = calibration_.cameras[i];
+    const int n = static_cast<int>(renderers_[i].VisibleLights(T_D_B * cam.T_B_C).size());
+    if (cam.role == CameraRole::kStereoLeft) r.n_stereo_left = n;
+    if (cam.role == CameraRole::kStereoRight) r.n_stereo_right = n;
+    if (cam.role == CameraRole::kMono) r.n_mono = n;
+  }
+  r.stage = StageFromLightCounts(r.n_stereo_left, r.n_stereo_right, r.n_mono);
+  return r;
+}
+
+namespace {
+
+// Number of samples of a sensor at rate_hz within [0, duration_s].
+int64_t SampleCount(double duration_s, double rate_hz) {
+  return static_cast<int64_t>(std::floor(duration_s * rate_hz + 1e-9)) + 1;
+}
+
+std::string DistractorDetail(const RenderedDistractor& d) {
+  return "u=" + FormatDouble(std::round(d.uv.x() * 100) / 100) + ";v=" +
+         FormatDouble(std::round(d.uv.y() * 100) / 100) + ";sigma_px=" +
+         FormatDouble(std::round(d.radius_px * 100) / 100);
+}
+
+}  // namespace
+
+SimulationSummary DockingSimulator::Run(const std::string& dir, const CancellationToken& cancel,
+                                        const std::function<void(double)>& progress) const {
+  const Scenario& s = scenario_;
+  const bool noisy = s.noise_enabled;
+  const Eigen::Vector3d& g_D = s.dock.gravity_D;
+  DatasetWriter writer(dir, calibration_, s.dock);
+
+  ImuSimulator imu(s.imu, g_D, s.initial_gyro_bias, s.initial_accel_bias, noisy,
+                   MakeRandomStream(s.seed, RandomStreamId::kImu));
+  DepthSimulator depth(s.depth, s.dock, noisy, MakeRandomStream(s.seed, RandomStreamId::kDepth));
+  DvlSimulator dvl(s.dvl, s.dvl_faults, noisy, MakeRandomStream(s.seed, RandomStreamId::kDvl));
+  AcousticSimulator acoustic(s.acoustic, s.dock, s.acoustic_faults, noisy,
+                             MakeRandomStream(s.seed, RandomStreamId::kAcoustic));
+  std::vector<std::mt19937_64> camera_rngs;
+  for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
+    camera_rngs.push_back(MakeRandomStream(
+        s.seed, static_cast<uint64_t>(RandomStreamId::kCameraBase) + static_cast<uint64_t>(i)));
+  }
+  SimulationSummary summary;
+  const int64_t n_imu = SampleCount(s.duration_s, s.imu.rate_hz);
+  const int64_t n_depth = SampleCount(s.duration_s, s.depth.rate_hz);
+  const int64_t n_dvl = SampleCount(s.duration_s, s.dvl.rate_hz);
+  const int64_t n_acoustic = SampleCount(s.duration_s, s.acoustic.rate_hz);
+  const int64_t n_frames = SampleCount(s.duration_s, s.cameras.rate_hz);
+  int64_t k_imu = 0, k_depth = 0, k_dvl = 0, k_acoustic = 0;
+
+  auto record_fault = [&](const std::optional<FaultRecord>& fault) {
+    if (fault) {
+      writer.AddFault(*fault);
+      ++summary.n_faults;
+    }
+  };
+  // Emits every non-camera sample with timestamp <= t_end_ns, in time order per sensor.
+  auto emit_until = [&](int64_t t_end_ns) {
+    for (; k_imu < n_imu && SampleTime(k_imu, s.imu.rate_hz) <= t_end_ns; ++k_imu) {
+      const int64_t t = SampleTime(k_imu, s.imu.rate_hz);
+      const KinematicState state = trajectory_.At(Seconds(t));
+      writer.AddImu(imu.Sample(t, state));
+      writer.AddGroundTruth({t, state.T_D_B, state.v_D, imu.gyro_bias(), imu.accel_bias()});
+      summary.max_speed_mps = std::max(summary.max_speed_mps, state.v_D.norm());
+      ++summary.n_imu;
+    }
+    for (; k_depth < n_depth && SampleTime(k_depth, s.depth.rate_hz) <= t_end_ns; ++k_depth) {
+      const int64_t t = SampleTime(k_depth, s.depth.rate_hz);
+      writer.AddDepth(depth.Sample(t, trajectory_.At(Seconds(t))));
+      ++summary.n_depth;
+    }
+    for (; k_dvl < n_dvl && SampleTime(k_dvl, s.dvl.rate_hz) <= t_end_ns; ++k_dvl) {
+      const int64_t t = SampleTime(k_dvl, s.dvl.rate_hz);
+      std::optional<FaultRecord> fault;
+      writer.AddDvl(dvl.Sample(t, trajectory_.At(Seconds(t)), &fault));
+      record_fault(fault);
+      ++summary.n_dvl;
+    }
+    for (; k_acoustic < n_acoustic && SampleTime(k_acoustic, s.acoustic.rate_hz) <= t_end_ns;
+         ++k_acoustic) {
+      const int64_t t = SampleTime(k_acoustic, s.acoustic.rate_hz);
+      std::optional<FaultRecord> fault;
+      writer.AddAcoustic(acoustic.Sample(t, trajectory_.At(Seconds(t)), &fault));
+      record_fault(fault);
+      ++summary.n_acoustic;
+    }
+  };
+
+  const double frame_period_s = 1.0 / s.cameras.rate_hz;
+  for (int64_t k = 0; k < n_frames; ++k) {
+    cancel.ThrowIfCancelled();
+    const int64_t t = SampleTime(k, s.cameras.rate_hz);
+    emit_until(t);
+    const VisibilityRecord visibility = VisibilityAt(t);
+    writer.AddVisibility(visibility);
+    summary.stage_duration_s[static_cast<int>(visibility.stage)] += frame_period_s;
+    if (s.cameras.render_images) {
+      const Pose3 T_D_B = trajectory_.At(Seconds(t)).T_D_B;
+      for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
+        const auto& cam = calibration_.cameras[i];
+        const RenderResult image = renderers_[i].Render(T_D_B * cam.T_B_C, camera_rngs[i]);
+        writer.AddImage(cam.name, t, image.image);
+        for (const auto& d : image.distractors) {
+          record_fault(FaultRecord{t, cam.name, d.kind, DistractorDetail(d)});
+        }
+      }
+    }
+    ++summary.n_camera_frames;
+    if (progress) progress(static_cast<double>(k + 1) / static_cast<double>(n_frames));
+  }
+  emit_until(std::numeric_limits<int64_t>::max());  // the tail after the last frame
+  writer.Close();
+  return summary;
+}
+
+}  // namespace auvdock

@@ -1,0 +1,17 @@
+// Scenario factories for tests: the default scenario, shortened and shrunk so ctest stays fast.
+#pragma once
+
+#include <string>
+
+#include "auvdock/sim/scenario.h"
+
+namespace auvdock::test {
+
+std::string SourcePath(const std::string& relative);  // path inside the source tree
+
+// data/scenarios/default.yaml as shipped (40 s, 640x512).
+Scenario DefaultScenario();
+// The default scenario cut to `duration_s` seconds, with 160x128 images (same field of view).
+Scenario ShortScenario(double duration_s = 2.0);
+
+}  // namespace auvdock::test
