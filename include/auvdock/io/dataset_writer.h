@@ -13,6 +13,7 @@
 #include "auvdock/io/calibration.h"
 #include "auvdock/io/csv.h"
 #include "auvdock/io/measurements.h"
+#include "auvdock/io/tum_io.h"
 
 namespace auvdock {
 
@@ -37,9 +38,8 @@ class DatasetWriter {
 
  private:
   std::string root_;
-  int png_compression_ = 1;  // zlib level: fast; PNG stays lossless at every level
   std::unique_ptr<CsvWriter> imu_, depth_, dvl_, acoustic_, groundtruth_, visibility_, faults_;
-  std::unique_ptr<CsvWriter> tum_;
+  std::unique_ptr<TumWriter> tum_;
   std::map<std::string, std::unique_ptr<CsvWriter>> cameras_;
 };
 

@@ -28,9 +28,9 @@ struct CameraRigConfig {
   std::array<double, 5> distortion{-0.05, 0.01, 0.0005, -0.0003, 0.0};
   double pixel_noise_px = 0.3;
   double stereo_baseline_m = 0.25;
-  double stereo_tilt_deg = 40.0;                                  // below the body x axis
+  double stereo_tilt_deg = 45.0;                                  // below the body x axis
   Eigen::Vector3d stereo_p_B = Eigen::Vector3d(0.9, 0.0, 0.2);    // midpoint of the pair
-  Eigen::Vector3d mono_p_B = Eigen::Vector3d(0.45, 0.0, 0.3);
+  Eigen::Vector3d mono_p_B = Eigen::Vector3d(0.75, 0.0, 0.3);
   bool render_images = true;
 };
 

@@ -1,0 +1,196 @@
+// auvdock evaluate: accuracy of an estimated trajectory (TUM file) against a dataset's ground
+// truth -- absolute error overall and per visibility stage, and relative pose error.
+// The metrics are defined in include/auvdock/eval/trajectory_evaluation.h.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "apps/commands.h"
+#include "auvdock/eval/trajectory_evaluation.h"
+#include "auvdock/geometry/so3.h"
+#include "auvdock/io/dataset.h"
+#include "auvdock/io/input_error.h"
+#include "auvdock/io/tum_io.h"
+
+namespace auvdock::cli {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+struct EvaluateOptions {
+  std::string dataset_dir;
+  std::string estimate_path;
+  bool json = false;
+  std::string align = "none";
+  double rpe_delta_s = 1.0;
+  double max_truth_gap_s = 0.1;
+};
+
+// CLI11's PositiveNumber prints its range up to DBL_MAX in full; this says what is meant.
+CLI::Validator PositiveSeconds() {
+  return CLI::Validator(
+      [](std::string& text) {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || !std::isfinite(value) || !(value > 0.0)) {
+          return "must be a positive number of seconds (got '" + text + "')";
+        }
+        return std::string();
+      },
+      "POSITIVE");
+}
+
+nlohmann::ordered_json Vector3Json(const Eigen::Vector3d& v) {
+  return nlohmann::ordered_json::array({v.x(), v.y(), v.z()});
+}
+
+nlohmann::ordered_json ReportJson(const EvaluateOptions& options, const EvaluationReport& report) {
+  nlohmann::ordered_json j;
+  j["dataset"] = options.dataset_dir;
+  j["estimate"] = options.estimate_path;
+  j["n_poses"] = report.overall.n;
+  j["n_skipped"] = report.n_skipped;
+  j["max_truth_gap_s"] = options.max_truth_gap_s;
+  j["pos_rmse_m"] = report.overall.pos_rmse_m;
+  j["att_rmse_rad"] = report.overall.att_rmse_rad;
+  j["pos_max_abs_m"] = Vector3Json(report.overall.pos_max_abs_m);
+  j["att_max_abs_rad"] = Vector3Json(report.overall.att_max_abs_rad);
+  j["pos_mean_m"] = Vector3Json(report.overall.pos_mean_m);
+  // NaN RMSEs (no pair) are written as null by nlohmann::json.
+  j["rpe"] = {{"delta_s", report.rpe.delta_s},
+              {"n_pairs", report.rpe.n_pairs},
+              {"trans_rmse_m", report.rpe.trans_rmse_m},
+              {"rot_rmse_rad", report.rpe.rot_rmse_rad}};
+  j["alignment"] = options.align;
+  nlohmann::ordered_json T = nlohmann::ordered_json::array();
+  const Eigen::Matrix4d M = report.alignment.Matrix();
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) T.push_back(M(r, c));
+  }
+  j["alignment_T"] = T;
+  nlohmann::ordered_json stages = nlohmann::ordered_json::object();
+  for (const auto& [stage, stats] : report.by_stage) {
+    stages[VisibilityStageName(stage)] = {{"n", stats.n},
+                                          {"pos_rmse_m", stats.pos_rmse_m},
+                                          {"att_rmse_rad", stats.att_rmse_rad},
+                                          {"pos_max_abs_m", Vector3Json(stats.pos_max_abs_m)},
+                                          {"att_max_abs_rad", Vector3Json(stats.att_max_abs_rad)},
+                                          {"pos_mean_m", Vector3Json(stats.pos_mean_m)}};
+  }
+  j["stages"] = stages;
+  return j;
+}
+
+void PrintTable(const EvaluateOptions& options, const EvaluationReport& report) {
+  std::printf("dataset    %s\n", options.dataset_dir.c_str());
+  std::printf("estimate   %s\n", options.estimate_path.c_str());
+  std::printf("poses      %d evaluated, %d skipped (outside the ground truth or in gaps > %g s)\n",
+              report.overall.n, report.n_skipped, options.max_truth_gap_s);
+  std::printf("alignment  %s", options.align.c_str());
+  if (options.align == "se3") {
+    const Eigen::Vector3d rpy = RollPitchYawFromQuaternion(report.alignment.q);
+    const Eigen::Vector3d& t = report.alignment.p;
+    std::printf(" (T_align: t = [%.4f %.4f %.4f] m, roll/pitch/yaw = [%.3f %.3f %.3f] deg)", t.x(),
+                t.y(), t.z(), rpy.x() * kRadToDeg, rpy.y() * kRadToDeg, rpy.z() * kRadToDeg);
+  }
+  std::printf("\n\n");
+
+  struct Row {
+    const char* name;
+    const ErrorStats* stats;
+  };
+  std::vector<Row> rows = {{"overall", &report.overall}};
+  for (const auto& [stage, stats] : report.by_stage) {
+    rows.push_back({VisibilityStageName(stage), &stats});
+  }
+
+  std::printf("%-20s %7s %9s %9s %9s %9s %9s %9s %9s\n", "position error [m]", "n", "rmse",
+              "max|x|", "max|y|", "max|z|", "mean x", "mean y", "mean z");
+  for (const Row& row : rows) {
+    const ErrorStats& s = *row.stats;
+    std::printf("  %-18s %7d %9.4f %9.4f %9.4f %9.4f %9.4f %9.4f %9.4f\n", row.name, s.n,
+                s.pos_rmse_m, s.pos_max_abs_m.x(), s.pos_max_abs_m.y(), s.pos_max_abs_m.z(),
+                s.pos_mean_m.x(), s.pos_mean_m.y(), s.pos_mean_m.z());
+  }
+  std::printf("\n%-20s %7s %9s %9s %9s %9s\n", "attitude error [deg]", "n", "rmse", "max|roll|",
+              "max|pitch|", "max|yaw|");
+  for (const Row& row : rows) {
+    const ErrorStats& s = *row.stats;
+    std::printf("  %-18s %7d %9.3f %9.3f %9.3f %9.3f\n", row.name, s.n, s.att_rmse_rad * kRadToDeg,
+                s.att_max_abs_rad.x() * kRadToDeg, s.att_max_abs_rad.y() * kRadToDeg,
+                s.att_max_abs_rad.z() * kRadToDeg);
+  }
+
+  std::printf("\nrelative pose error over %g s: %d pairs\n", report.rpe.delta_s,
+              report.rpe.n_pairs);
+  if (report.rpe.n_pairs > 0) {
+    std::printf("  translation rmse  %.4f m\n", report.rpe.trans_rmse_m);
+    std::printf("  rotation rmse     %.3f deg\n", report.rpe.rot_rmse_rad * kRadToDeg);
+  } else {
+    std::printf("  (no pose pair %g s apart within 10 %%)\n", report.rpe.delta_s);
+  }
+}
+
+void RunEvaluate(const EvaluateOptions& options) {
+  EvaluationOptions evaluation;
+  if (!ParseAlignment(options.align, &evaluation.alignment)) {
+    throw InputError("--align: expected none or se3 (got '" + options.align + "')");
+  }
+  evaluation.rpe_delta_s = options.rpe_delta_s;
+  evaluation.max_truth_gap_s = options.max_truth_gap_s;
+
+  const Dataset dataset = LoadDataset(options.dataset_dir);
+  if (dataset.groundtruth.empty()) {
+    throw InputError(options.dataset_dir + ": dataset has no ground truth");
+  }
+  const Trajectory estimate = ReadTumTrajectory(options.estimate_path);
+  if (estimate.empty()) throw InputError(options.estimate_path + ": trajectory has no poses");
+
+  const EvaluationReport report =
+      EvaluateTrajectory(dataset.groundtruth, estimate, dataset.visibility, evaluation);
+  if (options.json) {
+    std::cout << ReportJson(options, report).dump(2) << std::endl;
+  } else {
+    PrintTable(options, report);
+    std::fflush(stdout);
+  }
+}
+
+}  // namespace
+
+void AddEvaluateCommand(CLI::App& root) {
+  auto options = std::make_shared<EvaluateOptions>();
+  CLI::App* sub = root.add_subcommand(
+      "evaluate", "Compare an estimated trajectory (TUM file) with a dataset's ground truth");
+  sub->add_option("--dataset", options->dataset_dir, "Dataset folder with ground truth")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  sub->add_option("--estimate", options->estimate_path,
+                  "Estimated trajectory: TUM file 't tx ty tz qx qy qz qw' (T_D_B, s, m)")
+      ->required()
+      ->type_name("FILE.tum");
+  sub->add_flag("--json", options->json, "Print one JSON object instead of a table");
+  sub->add_option("--align", options->align,
+                  "Align the estimate to the truth first: none (default) or se3 (rigid)")
+      ->check(CLI::IsMember({"none", "se3"}))
+      ->type_name("MODE");
+  sub->add_option("--rpe-delta", options->rpe_delta_s,
+                  "Time step of the relative pose error, seconds (default 1)")
+      ->check(PositiveSeconds())
+      ->type_name("SECONDS");
+  sub->add_option("--max-truth-gap", options->max_truth_gap_s,
+                  "Skip estimate poses between ground-truth samples further apart than this, "
+                  "seconds (default 0.1)")
+      ->check(PositiveSeconds())
+      ->type_name("SECONDS");
+  sub->callback([options]() { RunEvaluate(*options); });
+}
+
+}  // namespace auvdock::cli

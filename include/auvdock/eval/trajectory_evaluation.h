@@ -1,0 +1,98 @@
+// Accuracy of an estimated trajectory against ground truth: absolute pose error (overall and
+// per visibility stage) and relative pose error over a fixed time step.
+//
+// Frames and units: poses are T_D_B (body B in dock frame D); positions in metres, angles in
+// radians, time in int64 nanoseconds (options in seconds).
+//
+// Matching: every estimate pose at time t is compared with the truth interpolated at t --
+// linearly in position, slerp in rotation, between the two truth samples around t (the sample
+// itself if t falls on one). Estimate poses before the first or after the last truth sample, or
+// between two truth samples more than max_truth_gap_s apart, are not evaluated (n_skipped).
+//
+// Absolute error of a matched pose (after the optional alignment, see below):
+//   e_p = p_est - p_true  (in D)
+//   pos_rmse_m = sqrt(mean |e_p|^2);  pos_max_abs_m = max |e_p| per axis x, y, z of D;
+//   pos_mean_m = mean e_p per axis (the bias).
+//   att angle = |Log(R_true^T R_est)| (geodesic);  att_rmse_rad = sqrt(mean angle^2).
+//   att_max_abs_rad = max |Wrap(euler_est - euler_true)| per Z-Y-X Euler angle (roll, pitch,
+//   yaw; so3.h). The per-axis Euler split is the readable one for a vehicle near level; it
+//   degrades near pitch = ±90 deg, where the geodesic angle stays meaningful.
+//
+// Relative pose error (Sturm et al., IROS 2012; Kümmerle et al. 2009) over delta = rpe_delta_s:
+// for each matched estimate pose i, j is the matched pose whose time is closest to t_i + delta
+// (pairs with |t_j - t_i - delta| > 0.1 delta are skipped), and
+//   E_ij = (T_true_i^-1 T_true_j)^-1 (T_est_i^-1 T_est_j);
+//   trans_rmse_m = sqrt(mean |p(E_ij)|^2),  rot_rmse_rad = sqrt(mean angle(E_ij)^2).
+// RPE measures drift and is invariant to a rigid change of the estimate's frame. With no pair,
+// n_pairs = 0 and the RMSEs are NaN.
+//
+// Alignment: Alignment::kNone compares the poses as they are (the estimator is meant to
+// estimate in the true dock frame D, so a frame offset is an error). Alignment::kSE3 first fits
+// T_align (trajectory_alignment.h) to all matched positions and replaces every estimate pose by
+// T_align * T_est, which shows the error that remains after removing a rigid frame offset.
+//
+// Stages: an estimate pose belongs to the stage of the last visibility record at or before its
+// time (kUnknown before the first record or with no records).
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "auvdock/geometry/pose3.h"
+#include "auvdock/geometry/stamped_pose.h"
+#include "auvdock/io/measurements.h"
+
+namespace auvdock {
+
+enum class Alignment { kNone, kSE3 };
+
+// "none", "se3".
+const char* AlignmentName(Alignment alignment);
+// Parses "none" or "se3"; returns false on anything else.
+bool ParseAlignment(const std::string& text, Alignment* alignment);
+
+struct EvaluationOptions {
+  Alignment alignment = Alignment::kNone;
+  double rpe_delta_s = 1.0;      // must be positive and finite
+  double max_truth_gap_s = 0.1;  // must be positive; +infinity never skips for a gap
+};
+
+struct ErrorStats {
+  int n = 0;  // number of matched poses
+  double pos_rmse_m = 0.0;
+  double att_rmse_rad = 0.0;
+  Eigen::Vector3d pos_max_abs_m = Eigen::Vector3d::Zero();    // x, y, z in D
+  Eigen::Vector3d att_max_abs_rad = Eigen::Vector3d::Zero();  // roll, pitch, yaw
+  Eigen::Vector3d pos_mean_m = Eigen::Vector3d::Zero();       // signed mean of p_est - p_true
+};
+
+struct RpeStats {
+  int n_pairs = 0;
+  double delta_s = 0.0;
+  double trans_rmse_m = 0.0;  // NaN when n_pairs == 0
+  double rot_rmse_rad = 0.0;  // NaN when n_pairs == 0
+};
+
+struct EvaluationReport {
+  ErrorStats overall;
+  RpeStats rpe;
+  // Only stages with n > 0, in the order of VisibilityStage.
+  std::vector<std::pair<VisibilityStage, ErrorStats>> by_stage;
+  int n_skipped = 0;  // estimate poses outside the truth span or in a truth gap
+  Pose3 alignment;    // T_align; identity with Alignment::kNone
+};
+
+// `truth` must have strictly increasing times, `estimate` too (else InputError); `visibility`
+// is expected in time order (it is sorted if not). Throws InputError if the truth is empty
+// ("dataset has no ground truth"), if no estimate pose can be matched ("estimate has no pose
+// within the ground-truth time span ..."), if the options are invalid, or if SE(3) alignment
+// is requested on degenerate (collinear) positions.
+EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
+                                    const Trajectory& estimate,
+                                    const std::vector<VisibilityRecord>& visibility,
+                                    const EvaluationOptions& options);
+
+}  // namespace auvdock

@@ -1,0 +1,349 @@
+#include "auvdock/sim/underwater_renderer.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <cstdint>
+
+namespace auvdock {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kFullScale = 255.0;
+// Lights emit into the half-space above the deck; beyond 85 deg from the vertical the housing
+// hides the emitter.
+const double kCosEmissionHalfAngle = std::cos(85.0 * kPi / 180.0);
+// Blur of the optics (lens + sensor), pixels: the smallest blob and the scale below which an
+// emitter is unresolved.
+constexpr double kMinSigmaPx = 0.8;
+// A light nearer than this to the camera centre is not drawn (it would fill the image).
+constexpr double kMinLightDepthM = 0.05;
+// Luma weights (ITU-R BT.601, as cv::cvtColor uses), B G R.
+const Eigen::Vector3d kLumaBgr(0.114, 0.587, 0.299);
+// Cyan-green guide light (LEDs around 500 nm), B G R, relative.
+const Eigen::Vector3d kLightColourBgr(0.85, 1.0, 0.2);
+// Lamp-lit marine snow is whitish.
+const Eigen::Vector3d kParticleColourBgr(1.0, 1.0, 0.85);
+// Sand/mud is slightly warmer than grey, B G R.
+const Eigen::Vector3f kSeabedTintBgr(0.85f, 1.0f, 1.1f);
+// The lamp irradiance 1/r^2 is capped at this range (m) so a surface touching the camera stays
+// finite.
+constexpr float kMinLampRangeM = 0.5f;
+
+// Seabed texture: one period of kTexturePeriodM metres in kTextureSize texels (3 cm). The wave
+// vectors are whole multiples of 2 pi / period along x and y so the table wraps seamlessly.
+constexpr int kTextureSize = 256;
+constexpr double kTexturePeriodM = 8.0;
+struct TextureWave {
+  int nx, ny;  // cycles per period along x and y of D
+  double amplitude;
+  double phase;
+};
+constexpr TextureWave kTextureWaves[] = {
+    {2, 1, 0.08, 0.3},    // 3.6 m ripples
+    {3, -5, 0.07, 1.7},   // 1.4 m
+    {-7, 4, 0.06, 4.1},   // 1.0 m
+    {11, 9, 0.05, 2.6}};  // 0.56 m
+
+// Random draws from the caller's generator, written out so that the image does not depend on the
+// standard library's distribution implementations.
+double Uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+double Uniform(std::mt19937_64& rng, double lo, double hi) {
+  return lo + (hi - lo) * Uniform01(rng);
+}
+
+double StandardNormal(std::mt19937_64& rng) {
+  const double u1 = 1.0 - Uniform01(rng);  // (0, 1]
+  const double u2 = Uniform01(rng);
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * kPi * u2);
+}
+
+int Poisson(std::mt19937_64& rng, double mean) {
+  if (!(mean > 0.0)) return 0;
+  if (mean > 30.0) {  // normal approximation; Knuth's product would underflow
+    return std::max(0, static_cast<int>(std::lround(mean + std::sqrt(mean) * StandardNormal(rng))));
+  }
+  const double limit = std::exp(-mean);
+  int count = 0;
+  double product = Uniform01(rng);
+  while (product > limit) {
+    ++count;
+    product *= Uniform01(rng);
+  }
+  return count;
+}
+
+// Adds amplitude_bgr * exp(-|x - uv|^2 / (2 sigma^2)) to a CV_32FC3 image. The support is a disc
+// around the exact centre, wide enough that the cut-off tail is below a quarter gray level (and
+// at least 4 sigma), so the drawn blob stays symmetric about uv.
+void AddGaussianBlob(const Eigen::Vector2d& uv, double sigma, const Eigen::Vector3d& amplitude_bgr,
+                     cv::Mat* image) {
+  const double amplitude_max = amplitude_bgr.maxCoeff();
+  if (!(amplitude_max > 0.0) || !(sigma > 0.0)) return;
+  const double support =
+      sigma * std::max(4.0, std::sqrt(2.0 * std::log(std::max(1.0, 4.0 * amplitude_max))));
+  const int u0 = std::max(0, static_cast<int>(std::ceil(uv.x() - support)));
+  const int u1 = std::min(image->cols - 1, static_cast<int>(std::floor(uv.x() + support)));
+  const int v0 = std::max(0, static_cast<int>(std::ceil(uv.y() - support)));
+  const int v1 = std::min(image->rows - 1, static_cast<int>(std::floor(uv.y() + support)));
+  if (u0 > u1 || v0 > v1) return;
+  const double inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
+  const double support2 = support * support;
+  std::vector<double> gx(u1 - u0 + 1);
+  for (int u = u0; u <= u1; ++u) {
+    const double dx = u - uv.x();
+    gx[u - u0] = std::exp(-dx * dx * inv_two_sigma2);
+  }
+  const float b = static_cast<float>(amplitude_bgr[0]);
+  const float g = static_cast<float>(amplitude_bgr[1]);
+  const float r = static_cast<float>(amplitude_bgr[2]);
+  for (int v = v0; v <= v1; ++v) {
+    const double dy = v - uv.y();
+    const double dy2 = dy * dy;
+    const double gy = std::exp(-dy2 * inv_two_sigma2);
+    float* row = image->ptr<float>(v);
+    for (int u = u0; u <= u1; ++u) {
+      const double dx = u - uv.x();
+      if (dx * dx + dy2 > support2) continue;
+      const float weight = static_cast<float>(gx[u - u0] * gy);
+      float* pixel = row + 3 * u;
+      pixel[0] += b * weight;
+      pixel[1] += g * weight;
+      pixel[2] += r * weight;
+    }
+  }
+}
+
+}  // namespace
+
+UnderwaterRenderer::UnderwaterRenderer(const CameraCalibration& camera, const DockModel& dock,
+                                       const WaterModel& water, const RenderOptions& options)
+    : camera_(camera), dock_(dock), water_(water), options_(options) {
+  const PinholeRadtanCamera& intrinsics = camera_.intrinsics;
+  const int width = intrinsics.width();
+  const int height = intrinsics.height();
+  assert(width > 0 && height > 0);
+
+  // The farthest corner sets the scale of the vignetting (its loss is options.vignetting).
+  double min_cos4 = 1.0;
+  for (const Eigen::Vector2d& corner :
+       {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(width - 0.5, -0.5),
+        Eigen::Vector2d(-0.5, height - 0.5), Eigen::Vector2d(width - 0.5, height - 0.5)}) {
+    const double c = intrinsics.Bearing(corner).z();
+    min_cos4 = std::min(min_cos4, c * c * c * c);
+  }
+  corner_falloff_ = std::max(1e-9, 1.0 - min_cos4);
+
+  pixel_rays_.resize(static_cast<size_t>(width) * height * 4);
+  float* ray = pixel_rays_.data();
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u, ray += 4) {
+      const Eigen::Vector3d bearing = intrinsics.Bearing(Eigen::Vector2d(u, v));
+      ray[0] = static_cast<float>(bearing.x());
+      ray[1] = static_cast<float>(bearing.y());
+      ray[2] = static_cast<float>(bearing.z());
+      ray[3] = static_cast<float>(kFullScale * options_.exposure * Vignette(bearing.z()));
+    }
+  }
+
+  seabed_texture_.resize(kTextureSize * kTextureSize);
+  for (int j = 0; j < kTextureSize; ++j) {
+    for (int i = 0; i < kTextureSize; ++i) {
+      double value = 1.0;
+      for (const TextureWave& wave : kTextureWaves) {
+        const double phase =
+            2.0 * kPi * (wave.nx * i + wave.ny * j) / static_cast<double>(kTextureSize);
+        value += wave.amplitude * std::sin(phase + wave.phase);
+      }
+      seabed_texture_[j * kTextureSize + i] = static_cast<float>(value);
+    }
+  }
+}
+
+double UnderwaterRenderer::Vignette(double cos_theta) const {
+  const double cos2 = cos_theta * cos_theta;
+  return 1.0 - options_.vignetting * (1.0 - cos2 * cos2) / corner_falloff_;
+}
+
+Eigen::Vector3d UnderwaterRenderer::LightAmplitude(const DockLight& light, double range_m,
+                                                   double cos_theta) const {
+  // Share of the emitter's core that survives the optics' blur: ~1 while the disc is resolved.
+  const double radius_px = camera_.intrinsics.fx() * light.radius_m / range_m;
+  const double blur_share =
+      1.0 - std::exp(-radius_px * radius_px / (2.0 * kMinSigmaPx * kMinSigmaPx));
+  const double gain = kFullScale * options_.exposure * Vignette(cos_theta) *
+                      options_.light_radiance * light.intensity * blur_share;
+  return gain * kLightColourBgr.cwiseProduct(water_.Transmission(range_m));
+}
+
+float UnderwaterRenderer::SeabedTexture(float x_D, float y_D) const {
+  constexpr float kTexelsPerM = static_cast<float>(kTextureSize / kTexturePeriodM);
+  const float tx = x_D * kTexelsPerM;
+  const float ty = y_D * kTexelsPerM;
+  const float fx = std::floor(tx);
+  const float fy = std::floor(ty);
+  const float ax = tx - fx;
+  const float ay = ty - fy;
+  // Far seabed ranges reach ~150 m: well inside int, and & wraps negatives correctly.
+  const int i0 = static_cast<int>(fx) & (kTextureSize - 1);
+  const int j0 = static_cast<int>(fy) & (kTextureSize - 1);
+  const int i1 = (i0 + 1) & (kTextureSize - 1);
+  const int j1 = (j0 + 1) & (kTextureSize - 1);
+  const float* row0 = &seabed_texture_[j0 * kTextureSize];
+  const float* row1 = &seabed_texture_[j1 * kTextureSize];
+  const float top = row0[i0] + ax * (row0[i1] - row0[i0]);
+  const float bottom = row1[i0] + ax * (row1[i1] - row1[i0]);
+  return top + ay * (bottom - top);
+}
+
+std::vector<RenderedLight> UnderwaterRenderer::VisibleLights(const Pose3& T_D_C) const {
+  const PinholeRadtanCamera& intrinsics = camera_.intrinsics;
+  const Pose3 T_C_D = T_D_C.Inverse();
+  std::vector<RenderedLight> visible;
+  for (const DockLight& light : dock_.lights) {
+    const Eigen::Vector3d p_C = T_C_D * light.p_D;
+    const auto uv = intrinsics.Project(p_C, kMinLightDepthM);
+    if (!uv || !intrinsics.InImage(*uv)) continue;
+    // Emitting side: the camera must lie within the emission cone about -z of D.
+    const Eigen::Vector3d light_to_camera = T_D_C.p - light.p_D;
+    const double range = light_to_camera.norm();
+    if (-light_to_camera.z() < kCosEmissionHalfAngle * range) continue;
+
+    const double peak = kLumaBgr.dot(LightAmplitude(light, range, p_C.z() / p_C.norm()));
+    if (!(peak >= options_.detection_threshold)) continue;
+
+    RenderedLight rendered;
+    rendered.light_id = light.id;
+    rendered.uv = *uv;
+    rendered.radius_px = std::max(kMinSigmaPx, intrinsics.fx() * light.radius_m / range);
+    rendered.peak = peak;
+    rendered.range_m = range;
+    visible.push_back(rendered);
+  }
+  return visible;
+}
+
+void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) const {
+  const int num_pixels = image->rows * image->cols;
+  assert(image->isContinuous() && image->type() == CV_32FC3);
+  const Eigen::Matrix3f R_D_C = T_D_C.R().cast<float>();
+  const Eigen::Vector3f p_D_C = T_D_C.p.cast<float>();
+  const float ox = p_D_C.x(), oy = p_D_C.y(), oz = p_D_C.z();
+  const float half_length = static_cast<float>(0.5 * dock_.deck_length_m);
+  const float half_width = static_cast<float>(0.5 * dock_.deck_width_m);
+  const float seabed_z = static_cast<float>(dock_.deck_height_m);
+  const Eigen::Vector3f c = water_.attenuation_per_m.cast<float>();
+  const Eigen::Vector3f A = water_.veiling_light.cast<float>();
+  const Eigen::Vector3f ambient = static_cast<float>(options_.ambient_light) * A;
+  const float lamp = static_cast<float>(options_.lamp_power);
+  const Eigen::Vector3f deck_albedo =
+      Eigen::Vector3f::Constant(static_cast<float>(options_.deck_albedo));
+  const Eigen::Vector3f seabed_albedo =
+      static_cast<float>(options_.seabed_albedo) * kSeabedTintBgr;
+  // Beyond this range every channel's transmission is below 1e-4: the pixel is veiling light.
+  const float max_range = static_cast<float>(std::log(1e4) / std::max(1e-6f, c.minCoeff()));
+  const float min_lamp_range2 = kMinLampRangeM * kMinLampRangeM;
+
+  const float* ray = pixel_rays_.data();
+  float* out = image->ptr<float>(0);
+  for (int k = 0; k < num_pixels; ++k, ray += 4, out += 3) {
+    const float rx = ray[0], ry = ray[1], rz = ray[2], gain = ray[3];
+    const float dx = R_D_C(0, 0) * rx + R_D_C(0, 1) * ry + R_D_C(0, 2) * rz;
+    const float dy = R_D_C(1, 0) * rx + R_D_C(1, 1) * ry + R_D_C(1, 2) * rz;
+    const float dz = R_D_C(2, 0) * rx + R_D_C(2, 1) * ry + R_D_C(2, 2) * rz;
+
+    float range = -1.0f;
+    Eigen::Vector3f albedo;
+    if (dz > 0.0f) {  // looking down (+z of D)
+      if (oz < 0.0f) {
+        const float s = -oz / dz;
+        const float x = ox + s * dx;
+        const float y = oy + s * dy;
+        if (std::fabs(x) <= half_length && std::fabs(y) <= half_width) {
+          range = s;
+          albedo = deck_albedo;
+        }
+      }
+      if (range < 0.0f && oz < seabed_z) {
+        const float s = (seabed_z - oz) / dz;
+        if (s < max_range) {
+          range = s;
+          albedo = SeabedTexture(ox + s * dx, oy + s * dy) * seabed_albedo;
+        }
+      }
+    }
+    if (range < 0.0f) {
+      out[0] = gain * A[0];
+      out[1] = gain * A[1];
+      out[2] = gain * A[2];
+      continue;
+    }
+    // Lamp at the camera: incidence angle = viewing angle (cos = dz for a horizontal surface),
+    // beam cos^2 off the optical axis, inverse square law.
+    const float lamp_term = lamp * dz * rz * rz / std::max(range * range, min_lamp_range2);
+    for (int ch = 0; ch < 3; ++ch) {
+      const float t = std::exp(-c[ch] * range);
+      const float J = albedo[ch] * (ambient[ch] + lamp_term * t);
+      out[ch] = gain * (J * t + A[ch] * (1.0f - t));
+    }
+  }
+}
+
+RenderResult UnderwaterRenderer::Render(const Pose3& T_D_C, std::mt19937_64& rng) const {
+  const PinholeRadtanCamera& intrinsics = camera_.intrinsics;
+  const int width = intrinsics.width();
+  const int height = intrinsics.height();
+  cv::Mat image(height, width, CV_32FC3);
+  RenderBackground(T_D_C, &image);
+
+  RenderResult result;
+  result.lights = VisibleLights(T_D_C);
+  const Pose3 T_C_D = T_D_C.Inverse();
+  for (const RenderedLight& rendered : result.lights) {
+    // VisibleLights reported the luma of this amplitude; the blob needs the colour channels.
+    const DockLight* light = dock_.FindLight(rendered.light_id);
+    const Eigen::Vector3d p_C = T_C_D * light->p_D;
+    const Eigen::Vector3d amplitude =
+        LightAmplitude(*light, rendered.range_m, p_C.z() / p_C.norm());
+    AddGaussianBlob(rendered.uv, rendered.radius_px, amplitude, &image);
+
+    if (options_.reflections) {
+      // Glint on the wet deck / camera port: dimmer, wider, below the light in the image.
+      const double sigma = rendered.radius_px;
+      const double fraction = Uniform(rng, 0.10, 0.25);
+      const double jitter_u = 0.3 * sigma * StandardNormal(rng);
+      const double jitter_v = 0.3 * sigma * StandardNormal(rng);
+      RenderedDistractor reflection;
+      reflection.kind = "reflection";
+      reflection.uv = rendered.uv + Eigen::Vector2d(jitter_u, 3.0 * sigma + 3.0 + jitter_v);
+      reflection.radius_px = 1.6 * sigma;
+      if (intrinsics.InImage(reflection.uv)) {
+        AddGaussianBlob(reflection.uv, reflection.radius_px, fraction * amplitude, &image);
+        result.distractors.push_back(reflection);
+      }
+    }
+  }
+
+  const int num_particles = Poisson(rng, options_.particles_per_frame);
+  for (int i = 0; i < num_particles; ++i) {
+    RenderedDistractor particle;
+    particle.kind = "particle";
+    particle.uv = Eigen::Vector2d(Uniform(rng, -0.5, width - 0.5), Uniform(rng, -0.5, height - 0.5));
+    particle.radius_px = Uniform(rng, 0.6, 1.5);
+    const double brightness = Uniform(rng, 60.0, 200.0) * options_.exposure;
+    AddGaussianBlob(particle.uv, particle.radius_px, brightness * kParticleColourBgr, &image);
+    result.distractors.push_back(particle);
+  }
+
+  if (options_.noise_sigma > 0.0) {
+    cv::RNG noise_rng(static_cast<uint64_t>(rng()));
+    cv::Mat noise(height, width, CV_32FC3);
+    noise_rng.fill(noise, cv::RNG::NORMAL, 0.0, options_.noise_sigma);
+    image += noise;
+  }
+  image.convertTo(result.image, CV_8UC3);  // rounds to nearest and clips to [0, 255]
+  return result;
+}
+
+}  // namespace auvdock

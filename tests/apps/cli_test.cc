@@ -1,0 +1,159 @@
+// End-to-end tests of the auvdock command line: simulate -> evaluate, and bad input
+// (one line on stderr, exit status 2, nothing half-written left behind).
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "auvdock/io/tum_io.h"
+#include "tests/testing/run_command.h"
+#include "tests/testing/temp_dir.h"
+#include "tests/testing/test_scenarios.h"
+
+namespace fs = std::filesystem;
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+
+namespace auvdock {
+namespace {
+
+int CountLines(const std::string& text) {
+  return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
+}
+
+// A short, small-image copy of the default scenario (the dock by absolute path).
+std::string WriteShortScenario(const test::TempDir& tmp, double duration_s,
+                               const std::string& extra = "") {
+  const std::string path = tmp / "short.yaml";
+  test::WriteTextFile(path, "name: short\nduration_s: " + std::to_string(duration_s) +
+                                "\ndock: " + test::SourcePath("data/docks/t_shape.yaml") +
+                                "\ncameras: {resolution: [160, 128]}\n" + extra);
+  return path;
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  // Simulates once for the whole suite.
+  static void SetUpTestSuite() {
+    tmp_ = new test::TempDir();
+    dataset_ = *tmp_ / "ds";
+    const auto r = test::RunAuvdock({"simulate", "--scenario", WriteShortScenario(*tmp_, 3.0),
+                                     "--out", dataset_, "--quiet"});
+    ASSERT_EQ(r.exit_status, 0) << r.err;
+  }
+  static void TearDownTestSuite() { delete tmp_; }
+
+  static test::TempDir* tmp_;
+  static std::string dataset_;
+};
+test::TempDir* CliTest::tmp_ = nullptr;
+std::string CliTest::dataset_;
+
+TEST_F(CliTest, SimulateWritesTheDatasetLayout) {
+  for (const char* f : {"calibration.yaml", "dock.yaml", "cam0/data.csv", "cam1/data.csv",
+                        "cam2/data.csv", "imu0/data.csv", "depth0/data.csv", "dvl0/data.csv",
+                        "usbl0/data.csv", "groundtruth/data.csv", "groundtruth/visibility.csv",
+                        "groundtruth/faults.csv", "groundtruth.tum"}) {
+    EXPECT_TRUE(fs::exists(dataset_ + "/" + f)) << f;
+  }
+  EXPECT_FALSE(fs::exists(dataset_ + ".partial-" + std::to_string(0)));
+}
+
+TEST_F(CliTest, EvaluateTruthAgainstItselfIsZero) {
+  const auto r = test::RunAuvdock(
+      {"evaluate", "--dataset", dataset_, "--estimate", dataset_ + "/groundtruth.tum", "--json"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("n_poses").get<int>(), 601);
+  EXPECT_LT(j.at("pos_rmse_m").get<double>(), 1e-9);
+  EXPECT_LT(j.at("att_rmse_rad").get<double>(), 1e-7);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT(j.at("pos_max_abs_m")[i].get<double>(), 1e-9);
+    EXPECT_LT(j.at("att_max_abs_rad")[i].get<double>(), 1e-7);
+  }
+}
+
+TEST_F(CliTest, EvaluateReturnsAKnownOffset) {
+  Trajectory estimate = ReadTumTrajectory(dataset_ + "/groundtruth.tum");
+  const Eigen::Vector3d offset(0.03, -0.02, 0.01);
+  for (auto& pose : estimate) pose.T_D_B.p += offset;
+  const std::string path = *tmp_ / "shifted.tum";
+  WriteTumTrajectory(path, estimate);
+  const auto r = test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate", path, "--json"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(j.at("pos_rmse_m").get<double>(), offset.norm(), 1e-9);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(j.at("pos_max_abs_m")[i].get<double>(), std::abs(offset[i]), 1e-9);
+    EXPECT_NEAR(j.at("pos_mean_m")[i].get<double>(), offset[i], 1e-9);
+  }
+  // The stages reported are those of the visibility file.
+  EXPECT_TRUE(j.at("stages").contains("stereo_only"));
+}
+
+TEST_F(CliTest, EvaluatePrintsATableByDefault) {
+  const auto r = test::RunAuvdock(
+      {"evaluate", "--dataset", dataset_, "--estimate", dataset_ + "/groundtruth.tum"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("stereo_only"));
+}
+
+TEST_F(CliTest, MalformedEstimateIsOneLineAndExitTwo) {
+  const std::string path = *tmp_ / "bad.tum";
+  test::WriteTextFile(path, "1700000000.0 0 0 0 0 0 0 1\n1700000000.1 0 0 zero 0 0 0 1\n");
+  const auto r = test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate", path});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_THAT(r.err, AllOf(HasSubstr(path), HasSubstr("line 2")));
+}
+
+TEST(Cli, UsageErrorsExitTwo) {
+  EXPECT_EQ(test::RunAuvdock({}).exit_status, 2);
+  EXPECT_EQ(test::RunAuvdock({"frobnicate"}).exit_status, 2);
+  const auto r = test::RunAuvdock({"simulate", "--out", "/tmp/x"});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_EQ(test::RunAuvdock({"--help"}).exit_status, 0);
+}
+
+TEST(Cli, BadScenarioNamesFileAndKeyAndWritesNothing) {
+  test::TempDir tmp;
+  const std::string scenario = WriteShortScenario(tmp, 1.0, "imu: {rate_hz: -200}\n");
+  const std::string out = tmp / "out";
+  const auto r = test::RunAuvdock({"simulate", "--scenario", scenario, "--out", out});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_THAT(r.err, AllOf(HasSubstr(scenario), HasSubstr("imu.rate_hz")));
+  EXPECT_FALSE(fs::exists(out));
+  EXPECT_EQ(std::distance(fs::directory_iterator(tmp.path()), fs::directory_iterator()), 1);
+}
+
+TEST(Cli, NonEmptyOutputFolderIsRefusedAndLeftAlone) {
+  test::TempDir tmp;
+  const std::string out = tmp / "out";
+  test::WriteTextFile(out + "/keep.txt", "mine");
+  const auto r = test::RunAuvdock(
+      {"simulate", "--scenario", WriteShortScenario(tmp, 1.0), "--out", out, "--quiet"});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_THAT(r.err, AllOf(HasSubstr(out), HasSubstr("not empty")));
+  EXPECT_EQ(test::ReadTextFile(out + "/keep.txt"), "mine");
+  EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator()), 1);
+}
+
+TEST(Cli, InterruptedSimulationLeavesNothingBehind) {
+  test::TempDir tmp;
+  const std::string out = tmp / "out";
+  const auto r = test::RunAuvdockAndSignal(
+      {"simulate", "--scenario", WriteShortScenario(tmp, 30.0), "--out", out, "--quiet"}, 0.5,
+      SIGINT);
+  EXPECT_EQ(r.exit_status, 130) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  // Only the scenario file remains: no staging folder.
+  EXPECT_EQ(std::distance(fs::directory_iterator(tmp.path()), fs::directory_iterator()), 1);
+}
+
+}  // namespace
+}  // namespace auvdock

@@ -1,0 +1,380 @@
+#include "auvdock/sim/underwater_renderer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "auvdock/sim/water_model.h"
+#include "tests/testing/render_fixture.h"
+
+namespace auvdock {
+namespace {
+
+constexpr WaterType kAllWaterTypes[] = {WaterType::kClear, WaterType::kCoastal,
+                                        WaterType::kTurbid};
+
+RenderOptions CleanOptions() {
+  RenderOptions options;
+  options.noise_sigma = 0.0;
+  options.reflections = false;
+  options.particles_per_frame = 0.0;
+  return options;
+}
+
+DockModel WithLights(const DockModel& dock, const std::vector<DockLight>& lights) {
+  DockModel copy = dock;
+  copy.lights = lights;
+  return copy;
+}
+
+// Intensity centroid of (image - background), summed over the channels, in a disc of the given
+// radius around centre. Returns false when the disc leaves the image or holds no signal.
+bool DifferenceCentroid(const cv::Mat& image, const cv::Mat& background,
+                        const Eigen::Vector2d& centre, double radius, Eigen::Vector2d* centroid,
+                        double* max_difference = nullptr) {
+  const int u0 = static_cast<int>(std::floor(centre.x() - radius));
+  const int u1 = static_cast<int>(std::ceil(centre.x() + radius));
+  const int v0 = static_cast<int>(std::floor(centre.y() - radius));
+  const int v1 = static_cast<int>(std::ceil(centre.y() + radius));
+  if (u0 < 0 || v0 < 0 || u1 >= image.cols || v1 >= image.rows) return false;
+  double sum = 0.0, sum_u = 0.0, sum_v = 0.0, max_seen = 0.0;
+  for (int v = v0; v <= v1; ++v) {
+    const cv::Vec3b* row = image.ptr<cv::Vec3b>(v);
+    const cv::Vec3b* row_bg = background.ptr<cv::Vec3b>(v);
+    for (int u = u0; u <= u1; ++u) {
+      if ((u - centre.x()) * (u - centre.x()) + (v - centre.y()) * (v - centre.y()) >
+          radius * radius) {
+        continue;
+      }
+      double w = 0.0;
+      for (int ch = 0; ch < 3; ++ch) w += static_cast<double>(row[u][ch]) - row_bg[u][ch];
+      max_seen = std::max(max_seen, w);
+      sum += w;
+      sum_u += w * u;
+      sum_v += w * v;
+    }
+  }
+  if (max_difference != nullptr) *max_difference = max_seen;
+  if (!(sum > 0.0)) return false;
+  *centroid = Eigen::Vector2d(sum_u / sum, sum_v / sum);
+  return true;
+}
+
+struct PoseCase {
+  const char* name;
+  Pose3 T_D_C;
+};
+
+std::vector<PoseCase> CentroidPoses() {
+  std::vector<PoseCase> poses;
+  for (double range : {2.0, 4.0, 6.0, 8.0}) {
+    poses.push_back({"forward_down_40", test::ApproachPose(range, 40.0)});
+    poses.push_back({"straight_down", test::ApproachPose(range, 90.0)});
+  }
+  // Off the axis and yawed: the lights land off the image centre, where distortion and
+  // vignetting are strongest.
+  poses.push_back({"oblique_offset",
+                   test::LookAt(Eigen::Vector3d(-3.0, 2.0, -2.5), Eigen::Vector3d(0.8, -0.6, 0.0))});
+  return poses;
+}
+
+TEST(WaterModelTest, NamesRoundTrip) {
+  for (WaterType type : kAllWaterTypes) {
+    WaterType parsed = WaterType::kClear;
+    ASSERT_TRUE(ParseWaterType(WaterTypeName(type), &parsed));
+    EXPECT_EQ(parsed, type);
+  }
+  WaterType parsed = WaterType::kCoastal;
+  EXPECT_FALSE(ParseWaterType("murky", &parsed));
+  EXPECT_FALSE(ParseWaterType("", &parsed));
+  EXPECT_EQ(parsed, WaterType::kCoastal);
+}
+
+TEST(WaterModelTest, TransmissionIsBeerLambert) {
+  const WaterModel water = WaterModel::ForType(WaterType::kCoastal);
+  EXPECT_TRUE(water.Transmission(0.0).isApprox(Eigen::Vector3d::Ones()));
+  const Eigen::Vector3d t = water.Transmission(3.0);
+  for (int ch = 0; ch < 3; ++ch) {
+    EXPECT_NEAR(t[ch], std::exp(-3.0 * water.attenuation_per_m[ch]), 1e-12);
+  }
+  // Multiplicative over path segments.
+  EXPECT_TRUE(water.Transmission(5.0).isApprox(
+      water.Transmission(2.0).cwiseProduct(water.Transmission(3.0))));
+}
+
+TEST(WaterModelTest, TypesArePhysicallyOrdered) {
+  const WaterModel clear = WaterModel::ForType(WaterType::kClear);
+  const WaterModel coastal = WaterModel::ForType(WaterType::kCoastal);
+  const WaterModel turbid = WaterModel::ForType(WaterType::kTurbid);
+  // Red is attenuated most in clear water; green least in coastal and turbid water.
+  EXPECT_GT(clear.attenuation_per_m[2], clear.attenuation_per_m[1]);
+  EXPECT_GT(clear.attenuation_per_m[1], clear.attenuation_per_m[0]);
+  for (const WaterModel* water : {&coastal, &turbid}) {
+    EXPECT_LT(water->attenuation_per_m[1], water->attenuation_per_m[0]);
+    EXPECT_LT(water->attenuation_per_m[1], water->attenuation_per_m[2]);
+  }
+  for (int ch = 0; ch < 3; ++ch) {
+    EXPECT_LT(clear.attenuation_per_m[ch], coastal.attenuation_per_m[ch]);
+    EXPECT_LT(coastal.attenuation_per_m[ch], turbid.attenuation_per_m[ch]);
+  }
+  for (const WaterModel* water : {&clear, &coastal, &turbid}) {
+    EXPECT_GE(water->veiling_light.minCoeff(), 0.0);
+    EXPECT_LE(water->veiling_light.maxCoeff(), 1.0);
+  }
+}
+
+// The core accuracy property: with noise off, every light's blob has its intensity centroid on
+// the light's projection through the camera model. Each light is rendered alone (a dock copy
+// with only that light) so that neighbouring blobs do not leak into its window.
+TEST(UnderwaterRendererTest, LightCentroidsMatchProjection) {
+  const CameraCalibration camera = test::MakeRigCamera();
+  const DockModel dock = test::MakeTDock();
+  const std::vector<PoseCase> poses = CentroidPoses();
+  for (WaterType type : kAllWaterTypes) {
+    SCOPED_TRACE(WaterTypeName(type));
+    const WaterModel water = WaterModel::ForType(type);
+    const UnderwaterRenderer full(camera, dock, water, CleanOptions());
+    const UnderwaterRenderer empty(camera, WithLights(dock, {}), water, CleanOptions());
+    std::vector<std::unique_ptr<UnderwaterRenderer>> single;
+    for (const DockLight& light : dock.lights) {
+      single.push_back(std::make_unique<UnderwaterRenderer>(camera, WithLights(dock, {light}),
+                                                            water, CleanOptions()));
+    }
+    int checked = 0;
+    double worst_error = 0.0;
+    for (const PoseCase& pose : poses) {
+      SCOPED_TRACE(pose.name);
+      std::mt19937_64 rng(1);
+      const cv::Mat background = empty.Render(pose.T_D_C, rng).image;
+      const std::vector<RenderedLight> visible = full.VisibleLights(pose.T_D_C);
+      for (const RenderedLight& light : visible) {
+        SCOPED_TRACE("light " + std::to_string(light.light_id) + " at " +
+                     std::to_string(light.range_m) + " m");
+        const RenderResult alone = single[light.light_id]->Render(pose.T_D_C, rng);
+        ASSERT_EQ(alone.lights.size(), 1u);
+        const auto projection =
+            camera.intrinsics.Project(pose.T_D_C.Inverse() * dock.lights[light.light_id].p_D);
+        ASSERT_TRUE(projection.has_value());
+        EXPECT_LT((alone.lights[0].uv - *projection).norm(), 1e-9);
+        Eigen::Vector2d centroid;
+        if (!DifferenceCentroid(alone.image, background, *projection, 5.0 * light.radius_px + 2.0,
+                                &centroid)) {
+          continue;  // window leaves the image
+        }
+        const double error = (centroid - *projection).norm();
+        worst_error = std::max(worst_error, error);
+        EXPECT_LT(error, 0.2) << "peak " << light.peak << " sigma " << light.radius_px;
+        ++checked;
+      }
+    }
+    EXPECT_GE(checked, 40);
+    RecordProperty(std::string("worst_centroid_error_px_") + WaterTypeName(type),
+                   std::to_string(worst_error));
+  }
+}
+
+// The same property on the full dock, for the lights whose window holds no other light.
+TEST(UnderwaterRendererTest, FullDockCentroidsMatchProjectionWhenSeparated) {
+  const CameraCalibration camera = test::MakeRigCamera();
+  const DockModel dock = test::MakeTDock();
+  const WaterModel water = WaterModel::ForType(WaterType::kCoastal);
+  const UnderwaterRenderer full(camera, dock, water, CleanOptions());
+  const UnderwaterRenderer empty(camera, WithLights(dock, {}), water, CleanOptions());
+  int checked = 0;
+  for (const PoseCase& pose : CentroidPoses()) {
+    SCOPED_TRACE(pose.name);
+    std::mt19937_64 rng(7);
+    const RenderResult result = full.Render(pose.T_D_C, rng);
+    const cv::Mat background = empty.Render(pose.T_D_C, rng).image;
+    for (const RenderedLight& light : result.lights) {
+      const double window = 5.0 * light.radius_px + 2.0;
+      bool separated = true;
+      for (const RenderedLight& other : result.lights) {
+        if (other.light_id == light.light_id) continue;
+        if ((other.uv - light.uv).norm() < window + 5.0 * other.radius_px) separated = false;
+      }
+      Eigen::Vector2d centroid;
+      if (!separated || !DifferenceCentroid(result.image, background, light.uv, window, &centroid)) {
+        continue;
+      }
+      EXPECT_LT((centroid - light.uv).norm(), 0.2) << "light " << light.light_id;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 10);
+}
+
+TEST(UnderwaterRendererTest, SameSeedIsByteIdenticalAndDifferentSeedsDiffer) {
+  const CameraCalibration camera = test::MakeRigCamera();
+  RenderOptions options;  // noise, reflections and particles all on
+  options.particles_per_frame = 5.0;
+  const UnderwaterRenderer renderer(camera, test::MakeTDock(),
+                                    WaterModel::ForType(WaterType::kCoastal), options);
+  const Pose3 T_D_C = test::ApproachPose(4.0, 40.0);
+  std::mt19937_64 rng_a(123), rng_b(123), rng_c(124);
+  const RenderResult a = renderer.Render(T_D_C, rng_a);
+  const RenderResult b = renderer.Render(T_D_C, rng_b);
+  const RenderResult c = renderer.Render(T_D_C, rng_c);
+  ASSERT_EQ(a.image.type(), CV_8UC3);
+  ASSERT_EQ(a.image.cols, 640);
+  ASSERT_EQ(a.image.rows, 512);
+  ASSERT_TRUE(a.image.isContinuous() && b.image.isContinuous());
+  EXPECT_EQ(std::memcmp(a.image.data, b.image.data, a.image.total() * a.image.elemSize()), 0);
+  ASSERT_EQ(a.distractors.size(), b.distractors.size());
+  for (size_t i = 0; i < a.distractors.size(); ++i) {
+    EXPECT_EQ(a.distractors[i].kind, b.distractors[i].kind);
+    EXPECT_EQ(a.distractors[i].uv, b.distractors[i].uv);
+  }
+  EXPECT_GT(cv::norm(a.image, c.image, cv::NORM_L1), 0.0);
+  // The generator advanced: the next frame is a different draw.
+  const RenderResult a2 = renderer.Render(T_D_C, rng_a);
+  EXPECT_GT(cv::norm(a.image, a2.image, cv::NORM_L1), 0.0);
+}
+
+TEST(UnderwaterRendererTest, DistractorsAreReported) {
+  const CameraCalibration camera = test::MakeRigCamera();
+  RenderOptions options;
+  options.particles_per_frame = 8.0;
+  const UnderwaterRenderer renderer(camera, test::MakeTDock(),
+                                    WaterModel::ForType(WaterType::kClear), options);
+  const Pose3 T_D_C = test::ApproachPose(6.0, 60.0);
+  std::mt19937_64 rng(5);
+  int particles = 0, reflections = 0;
+  for (int frame = 0; frame < 20; ++frame) {
+    const RenderResult result = renderer.Render(T_D_C, rng);
+    ASSERT_EQ(result.lights.size(), 6u);
+    for (const RenderedDistractor& d : result.distractors) {
+      EXPECT_TRUE(camera.intrinsics.InImage(d.uv));
+      if (d.kind == "particle") {
+        ++particles;
+        EXPECT_GE(d.radius_px, 0.6);
+        EXPECT_LE(d.radius_px, 1.5);
+      } else {
+        ASSERT_EQ(d.kind, "reflection");
+        ++reflections;
+      }
+    }
+  }
+  EXPECT_EQ(reflections, 20 * 6);          // every light's reflection stays in the image here
+  EXPECT_NEAR(particles / 20.0, 8.0, 3.0);  // Poisson mean
+}
+
+TEST(UnderwaterRendererTest, InvisibleLightsAreNotReported) {
+  const CameraCalibration camera = test::MakeRigCamera();
+  const DockModel dock = test::MakeTDock();
+  const UnderwaterRenderer renderer(camera, dock, WaterModel::ForType(WaterType::kClear),
+                                    CleanOptions());
+  std::mt19937_64 rng(3);
+  // Dock behind the camera: above the dock, looking up and away.
+  const Pose3 looking_away =
+      test::LookAt(Eigen::Vector3d(-3.0, 0.0, -3.0), Eigen::Vector3d(-10.0, 0.0, -6.0));
+  EXPECT_TRUE(renderer.VisibleLights(looking_away).empty());
+  EXPECT_TRUE(renderer.Render(looking_away, rng).lights.empty());
+  // Dock far outside the field of view, in front of the camera.
+  const Pose3 looking_aside =
+      test::LookAt(Eigen::Vector3d(-4.0, 0.0, -3.0), Eigen::Vector3d(-4.0, 8.0, 0.0));
+  EXPECT_TRUE(renderer.VisibleLights(looking_aside).empty());
+  // Below the emission cone: a camera level with the deck sees the lights' sides.
+  const Pose3 level = test::LookAt(Eigen::Vector3d(-5.0, 0.0, 0.1), Eigen::Vector3d::Zero());
+  EXPECT_TRUE(renderer.VisibleLights(level).empty());
+  // Part of the dock in view: exactly the lights in front and inside the image are reported.
+  const Pose3 partial = test::LookAt(Eigen::Vector3d(-1.5, 0.0, -1.5), Eigen::Vector3d(-1.5, 1.0, 0.3));
+  const std::vector<RenderedLight> visible = renderer.VisibleLights(partial);
+  int expected = 0;
+  for (const DockLight& light : dock.lights) {
+    const auto uv = camera.intrinsics.Project(partial.Inverse() * light.p_D);
+    const bool in_view = uv.has_value() && camera.intrinsics.InImage(*uv);
+    expected += in_view ? 1 : 0;
+    bool reported = false;
+    for (const RenderedLight& r : visible) reported |= r.light_id == light.id;
+    EXPECT_EQ(reported, in_view) << "light " << light.id;
+  }
+  EXPECT_GT(expected, 0);
+  EXPECT_LT(expected, 6);
+  EXPECT_EQ(renderer.Render(partial, rng).lights.size(), visible.size());
+}
+
+TEST(UnderwaterRendererTest, TurbidWaterDimsTheLights) {
+  const CameraCalibration camera = test::MakeRigCamera();
+  const DockModel dock = test::MakeTDock();
+  const Pose3 T_D_C = test::ApproachPose(4.0, 90.0);
+  std::map<WaterType, std::vector<RenderedLight>> lights;
+  std::map<WaterType, double> image_peak;
+  for (WaterType type : kAllWaterTypes) {
+    const WaterModel water = WaterModel::ForType(type);
+    const UnderwaterRenderer renderer(camera, dock, water, CleanOptions());
+    const UnderwaterRenderer empty(camera, WithLights(dock, {}), water, CleanOptions());
+    std::mt19937_64 rng(11);
+    const RenderResult result = renderer.Render(T_D_C, rng);
+    const cv::Mat background = empty.Render(T_D_C, rng).image;
+    lights[type] = result.lights;
+    ASSERT_EQ(result.lights.size(), 6u) << WaterTypeName(type);
+    Eigen::Vector2d centroid;
+    double max_difference = 0.0;
+    ASSERT_TRUE(DifferenceCentroid(result.image, background, result.lights[1].uv,
+                                   3.0 * result.lights[1].radius_px, &centroid, &max_difference));
+    image_peak[type] = max_difference;
+  }
+  for (size_t i = 0; i < 6; ++i) {
+    EXPECT_DOUBLE_EQ(lights[WaterType::kClear][i].range_m, lights[WaterType::kTurbid][i].range_m);
+    EXPECT_GT(lights[WaterType::kClear][i].peak, lights[WaterType::kCoastal][i].peak);
+    EXPECT_GT(lights[WaterType::kCoastal][i].peak, lights[WaterType::kTurbid][i].peak);
+  }
+  EXPECT_GT(image_peak[WaterType::kClear], image_peak[WaterType::kTurbid]);
+  EXPECT_LT(lights[WaterType::kTurbid][1].peak, 255.0);  // not saturated at 4 m
+}
+
+TEST(UnderwaterRendererTest, FarLightsLookSmallerAndDimmer) {
+  const CameraCalibration camera = test::MakeRigCamera();
+  const UnderwaterRenderer renderer(camera, test::MakeTDock(),
+                                    WaterModel::ForType(WaterType::kCoastal), CleanOptions());
+  // Within one oblique view: sorted by range, radius and peak fall.
+  std::vector<RenderedLight> visible = renderer.VisibleLights(test::ApproachPose(3.0, 30.0));
+  ASSERT_EQ(visible.size(), 6u);
+  std::sort(visible.begin(), visible.end(),
+            [](const RenderedLight& a, const RenderedLight& b) { return a.range_m < b.range_m; });
+  for (size_t i = 1; i < visible.size(); ++i) {
+    if (visible[i].range_m > visible[i - 1].range_m + 1e-6) {
+      EXPECT_LT(visible[i].radius_px, visible[i - 1].radius_px);
+    }
+  }
+  // The same light from 2 m and from 8 m.
+  const auto near = renderer.VisibleLights(test::ApproachPose(2.0, 90.0));
+  const auto far = renderer.VisibleLights(test::ApproachPose(8.0, 90.0));
+  ASSERT_FALSE(near.empty());
+  ASSERT_FALSE(far.empty());
+  ASSERT_EQ(near[0].light_id, far[0].light_id);
+  EXPECT_LT(far[0].radius_px, near[0].radius_px);
+  EXPECT_LT(far[0].peak, near[0].peak);
+  EXPECT_NEAR(near[0].radius_px * near[0].range_m, far[0].radius_px * far[0].range_m, 1e-9);
+}
+
+// The brightness budget: close lights saturate; lights stay detectable to ~9 m in clear and
+// coastal water and ~4.5 m in turbid water, and fade out beyond.
+TEST(UnderwaterRendererTest, DetectionRangesMatchTheWaterTypes) {
+  const CameraCalibration camera = test::MakeRigCamera();
+  const DockModel dock = test::MakeTDock();
+  auto visible_count = [&](WaterType type, double range) {
+    const UnderwaterRenderer renderer(camera, dock, WaterModel::ForType(type), CleanOptions());
+    return renderer.VisibleLights(test::ApproachPose(range, 90.0)).size();
+  };
+  EXPECT_EQ(visible_count(WaterType::kClear, 9.5), 6u);
+  EXPECT_EQ(visible_count(WaterType::kCoastal, 9.5), 6u);
+  EXPECT_EQ(visible_count(WaterType::kTurbid, 4.5), 6u);
+  EXPECT_EQ(visible_count(WaterType::kTurbid, 9.0), 0u);
+  EXPECT_EQ(visible_count(WaterType::kCoastal, 25.0), 0u);
+  const UnderwaterRenderer clear(camera, dock, WaterModel::ForType(WaterType::kClear),
+                                 CleanOptions());
+  for (const RenderedLight& light : clear.VisibleLights(test::ApproachPose(2.0, 90.0))) {
+    EXPECT_GT(light.peak, 255.0);
+  }
+}
+
+}  // namespace
+}  // namespace auvdock

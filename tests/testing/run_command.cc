@@ -1,0 +1,60 @@
+#include "tests/testing/run_command.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <stdexcept>
+#include <thread>
+
+#include "tests/testing/temp_dir.h"
+
+namespace auvdock::test {
+
+namespace {
+
+CommandResult Run(const std::vector<std::string>& args, double delay_s, int signal) {
+  TempDir capture;
+  const std::string out_path = capture / "out.txt", err_path = capture / "err.txt";
+  const pid_t pid = ::fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(out, 1);
+    ::dup2(err, 2);
+    std::vector<char*> argv;
+    std::string program = AUVDOCK_CLI_PATH;
+    argv.push_back(program.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(program.c_str(), argv.data());
+    std::_Exit(127);
+  }
+  if (signal != 0) {
+    std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
+    ::kill(pid, signal);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  CommandResult result;
+  result.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  result.out = ReadTextFile(out_path);
+  result.err = ReadTextFile(err_path);
+  return result;
+}
+
+}  // namespace
+
+CommandResult RunAuvdock(const std::vector<std::string>& args) { return Run(args, 0.0, 0); }
+
+CommandResult RunAuvdockAndSignal(const std::vector<std::string>& args, double delay_s,
+                                  int signal) {
+  return Run(args, delay_s, signal);
+}
+
+}  // namespace auvdock::test

@@ -1,0 +1,21 @@
+// Runs the auvdock CLI as a child process and captures its exit status, stdout and stderr.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace auvdock::test {
+
+struct CommandResult {
+  int exit_status = -1;
+  std::string out;
+  std::string err;
+};
+
+// Runs build/bin/auvdock with the arguments (no shell involved).
+CommandResult RunAuvdock(const std::vector<std::string>& args);
+
+// Starts build/bin/auvdock, sends `signal` after `delay_s`, waits; returns the exit status.
+CommandResult RunAuvdockAndSignal(const std::vector<std::string>& args, double delay_s, int signal);
+
+}  // namespace auvdock::test
