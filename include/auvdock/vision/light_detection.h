@@ -1,0 +1,44 @@
+// A guide light found in one image, and the identity the matchers assign to it.
+//
+// uv: intensity-weighted sub-pixel centroid in the raw (distorted) image, pixels, with (0, 0)
+// the centre of the top-left pixel (OpenCV). radius_px: equivalent radius sqrt(area / pi) of
+// the blob above threshold. peak: maximum gray level (0-255) in the blob. score: detection
+// confidence in [0, 1] from the size, shape and brightness checks (1 = a perfect light).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace auvdock {
+
+struct LightDetection {
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();
+  double radius_px = 0.0;
+  double peak = 0.0;
+  double score = 0.0;
+};
+
+// One detection assigned to one dock light.
+struct LightMatch {
+  int detection = -1;  // index into the detections of the image
+  int light_id = -1;   // DockLight::id
+};
+
+enum class MatchStatus {
+  kOk,         // a unique, verified assignment
+  kAmbiguous,  // two or more assignments explain the image about equally well: not used
+  kFailed,     // no assignment explains the image (too few lights, no consensus)
+};
+
+const char* MatchStatusName(MatchStatus status);
+
+struct MatchResult {
+  MatchStatus status = MatchStatus::kFailed;
+  std::vector<LightMatch> matches;  // empty unless kOk
+  std::string reason;               // why not kOk, for logs and "no pose" results
+  double cost = 0.0;                // matcher-specific: mean cost or RMS reprojection error (px)
+};
+
+}  // namespace auvdock
