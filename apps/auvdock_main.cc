@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "auvdock 0.1.0");
   auvdock::cli::AddSimulateCommand(app);
   auvdock::cli::AddEvaluateCommand(app);
+  auvdock::cli::AddFrontendCommand(app);
+  auvdock::cli::AddPnpCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -9,5 +9,7 @@ namespace auvdock::cli {
 
 void AddSimulateCommand(CLI::App& root);
 void AddEvaluateCommand(CLI::App& root);
+void AddPnpCommand(CLI::App& root);
+void AddFrontendCommand(CLI::App& root);
 
 }  // namespace auvdock::cli

@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libceres-dev libsuitesparse-dev
   libopencv-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  opencv-doc  # sample chessboards (examples/data/left*.jpg) for the PnP agreement tests
 )
 
 missing=()

@@ -24,6 +24,21 @@ CsvReader::CsvReader(const std::string& path, std::vector<std::string> columns, 
   if (!in_) throw InputError(path + ": cannot open file");
 }
 
+void CsvReader::ExpectNamedHeaderRow() {
+  const bool saved = allow_extra_;
+  allow_extra_ = false;
+  std::string expected;
+  for (const auto& c : columns_) expected += (expected.empty() ? "" : ",") + c;
+  if (!Next()) Fail("empty file: expected the header row '" + expected + "'");
+  allow_extra_ = saved;
+  for (std::size_t i = 0; i < columns_.size(); ++i) {
+    if (fields_[i] != columns_[i]) {
+      Fail("expected the header row '" + expected + "' (column " + std::to_string(i + 1) +
+           " is '" + fields_[i] + "')");
+    }
+  }
+}
+
 bool CsvReader::Next() {
   std::string text;
   while (std::getline(in_, text)) {

@@ -10,6 +10,19 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kFullScale = 255.0;
+
+// Camera response of the scene (not of the lights): linear up to kKneeLevel gray levels, then
+// compressed towards kSceneCeiling, as an auto-exposed camera keeps a lamp-lit deck at close
+// range out of saturation. Lights are added after it and do saturate; over an unsaturated,
+// smooth background their saturated core stays symmetric about the projection.
+constexpr float kKneeLevel = 140.0f;
+constexpr float kSceneCeiling = 190.0f;
+inline float SoftKnee(float level) {
+  if (level <= kKneeLevel) return level;
+  const float excess = level - kKneeLevel;
+  const float room = kSceneCeiling - kKneeLevel;
+  return kKneeLevel + excess / (1.0f + excess / room);
+}
 // Lights emit into the half-space above the deck; beyond 85 deg from the vertical the housing
 // hides the emitter.
 const double kCosEmissionHalfAngle = std::cos(85.0 * kPi / 180.0);
@@ -285,7 +298,7 @@ void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) co
     for (int ch = 0; ch < 3; ++ch) {
       const float t = std::exp(-c[ch] * range);
       const float J = albedo[ch] * (ambient[ch] + lamp_term * t);
-      out[ch] = gain * (J * t + A[ch] * (1.0f - t));
+      out[ch] = SoftKnee(gain * (J * t + A[ch] * (1.0f - t)));
     }
   }
 }

@@ -20,6 +20,10 @@ class CsvReader {
   // must have exactly columns.size() fields (or at least that many when allow_extra).
   CsvReader(const std::string& path, std::vector<std::string> columns, bool allow_extra = false);
 
+  // For user files whose first row names the columns ("X,Y,Z,u,v"): reads that row and
+  // throws unless it lists exactly the expected names.
+  void ExpectNamedHeaderRow();
+
   // Reads the next non-empty row; false at the end of the file.
   bool Next();
 

@@ -1,0 +1,91 @@
+// Monocular pose from known 3-D points and their pixels (Perspective-n-Point): the pose of the
+// dock seen by one camera (seed 000, section 3.2, eq. 10).
+//
+// Problem (eq. 10, in the raw distorted image):
+//   (R, t) = argmin 1/2 sum_i |pi(R X_i + t) - u_i|^2
+// with X_i the model points (dock frame D, metres), u_i the detected pixels (distorted, OpenCV
+// pixel convention) and pi the full pinhole + radial-tangential projection of
+// PinholeRadtanCamera. The pose is T_C_D: x_C = R X + t (OpenCV's rvec/tvec convention).
+//
+// Method:
+//   1. Closed-form starts on undistorted normalized coordinates (the distortion is only
+//      inverted here):
+//      - (nearly) coplanar points: a homography DLT on the points' best-fit plane, decomposed
+//        as H ~ [r1 r2 t] (Zhang, PAMI 2000), plus its mirror about the line of sight (the
+//        second minimum of a planar target seen nearly fronto-parallel);
+//      - non-coplanar points: EPnP (Lepetit, Moreno-Noguer, Fua, IJCV 2009) with the N = 1..3
+//        kernel approximations and a Gauss-Newton polish of the betas;
+//      - at most 5 points (where both of the above are fragile, e.g. 4 of 5 dock lights on one
+//        line leave the homography undetermined): P3P on every triple (Grunert's law-of-cosines
+//        system reduced to a quartic), the 3 poses that best reproject all points;
+//      - initial_T_C_D, when given.
+//      Points with a thickness between the planar and non-planar regimes get both kinds.
+//   2. Levenberg-Marquardt (Marquardt's diagonal damping, Nielsen's damping update) on the
+//      pixel residuals through the full distortion model, with the analytic Jacobian
+//        d u/d x_C = diag(fx, fy) * d(distort)/d(x, y) * [1/Z 0 -X/Z^2; 0 1/Z -Y/Z^2],
+//      over a left perturbation R <- Exp(dtheta) R, t <- t + dt, so that
+//        d x_C/d dtheta = -[R X]x,   d x_C/d dt = I.
+//      Every start is refined; the lowest final cost among the converged starts with every
+//      point in front of the camera wins. (OpenCV's SOLVEPNP_ITERATIVE refines one start and
+//      can stop in a worse local minimum with few or noisy points; where both reach the same
+//      minimum they agree to its tolerance, ~1e-7.)
+//   3. Covariance by first-order propagation at the solution, Sigma = pixel_sigma^2 I:
+//        P_local = (J^T Sigma^-1 J)^-1                 over (dtheta, dt)
+//        P       = G P_local G^T,  G = blockdiag(Jl(rvec)^-1, I)
+//      where rvec = Log(R) and Jl is the left Jacobian of SO(3), because
+//      Exp(rvec + d rvec) = Exp(Jl(rvec) d rvec) Exp(rvec). P is the covariance of OpenCV's
+//      parameters (rvec, tvec); P_local is also returned for the estimator's manifold.
+//
+// With exactly 3 points P3P has up to 4 exact solutions, so without initial_T_C_D the answer
+// is "ambiguous" (ok = false); with it, the solver refines from it (6 residuals, 6 unknowns).
+//
+// Frames and units: X in the model (dock) frame D, metres; pixels in the raw image; the
+// rotation vector in radians, translation in metres.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "auvdock/camera/pinhole_radtan_camera.h"
+#include "auvdock/geometry/pose3.h"
+
+namespace auvdock {
+
+struct PnpOptions {
+  int max_iterations = 50;   // Levenberg-Marquardt iterations per start
+  double pixel_sigma = 0.3;  // 1-sigma pixel noise per coordinate, for the covariance
+  // Converged when max_k |J^T r|_k <= gradient_tolerance * max_k |J^T r|_k at the start,
+  // or when the step |delta| <= step_tolerance * (|(rvec, t)| + step_tolerance),
+  // or when an accepted step lowers the cost by less than function_tolerance * cost.
+  double gradient_tolerance = 1e-10;
+  double step_tolerance = 1e-12;
+  double function_tolerance = 1e-14;
+};
+
+struct PnpResult {
+  bool ok = false;
+  std::string reason;  // why not ok (empty when ok)
+  Pose3 T_C_D;         // model (dock) -> camera: x_C = R X + t, OpenCV's convention
+  // Covariance of (rvec, t): rvec = Log(R) (OpenCV's Rodrigues vector, |rvec| <= pi, rad),
+  // t in metres, in that order.
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  // Covariance of the left perturbation (dtheta, dt): R = Exp(dtheta) R_hat, t = t_hat + dt.
+  Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
+  double rms_px = 0;   // sqrt(mean_i |pi(x_Ci) - u_i|^2), pixels
+  int iterations = 0;  // Levenberg-Marquardt iterations of the winning start
+};
+
+// points_D[i] projects to pixels_distorted[i]. See the file comment for the method.
+// ok = false with a reason for: fewer than 3 correspondences, size mismatch, NaN/Inf input,
+// collinear model points, 3 points without initial_T_C_D (ambiguous), points behind the camera
+// at the solution, singular normal equations (an unobservable pose), no convergence, and a
+// non-positive pixel_sigma.
+PnpResult SolvePnp(const std::vector<Eigen::Vector3d>& points_D,
+                   const std::vector<Eigen::Vector2d>& pixels_distorted,
+                   const PinholeRadtanCamera& camera, const PnpOptions& options = {},
+                   const std::optional<Pose3>& initial_T_C_D = std::nullopt);
+
+}  // namespace auvdock

@@ -1,0 +1,96 @@
+#include "auvdock/io/camera_file.h"
+
+#include <cmath>
+#include <fstream>
+
+#include <opencv2/core.hpp>
+
+#include "auvdock/io/calibration.h"
+#include "auvdock/io/input_error.h"
+
+namespace auvdock {
+
+namespace {
+
+bool IsOpenCvFileStorage(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open file");
+  std::string first;
+  std::getline(in, first);
+  return first.rfind("%YAML", 0) == 0 || first.rfind("<?xml", 0) == 0;
+}
+
+cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& path, const std::string& key) {
+  const cv::FileNode node = fs[key];
+  if (node.empty()) throw InputError(path + ": key '" + key + "': missing");
+  cv::Mat m;
+  try {
+    node >> m;
+  } catch (const cv::Exception&) {
+    throw InputError(path + ": key '" + key + "': not a matrix");
+  }
+  if (m.empty()) throw InputError(path + ": key '" + key + "': empty matrix");
+  m.convertTo(m, CV_64F);
+  for (int i = 0; i < static_cast<int>(m.total()); ++i) {
+    if (!std::isfinite(m.at<double>(i))) {
+      throw InputError(path + ": key '" + key + "': not a finite number");
+    }
+  }
+  return m;
+}
+
+int ReadPositiveInt(const cv::FileStorage& fs, const std::string& path, const std::string& key) {
+  const cv::FileNode node = fs[key];
+  if (node.empty() || !node.isInt()) {
+    throw InputError(path + ": key '" + key + "': missing or not an integer");
+  }
+  const int v = static_cast<int>(node);
+  if (v <= 0) throw InputError(path + ": key '" + key + "': must be positive");
+  return v;
+}
+
+CameraCalibration LoadOpenCvCamera(const std::string& path) {
+  cv::FileStorage fs;
+  try {
+    fs.open(path, cv::FileStorage::READ);
+  } catch (const cv::Exception& e) {
+    throw InputError(path + ": malformed OpenCV calibration file");
+  }
+  if (!fs.isOpened()) throw InputError(path + ": cannot open OpenCV calibration file");
+  const cv::Mat K = ReadMatrix(fs, path, "camera_matrix");
+  if (K.rows != 3 || K.cols != 3 || !(K.at<double>(0, 0) > 0) || !(K.at<double>(1, 1) > 0)) {
+    throw InputError(path + ": key 'camera_matrix': expected a 3x3 matrix with positive fx, fy");
+  }
+  const cv::Mat d = ReadMatrix(fs, path, "distortion_coefficients");
+  if (d.total() != 4 && d.total() != 5) {
+    throw InputError(path + ": key 'distortion_coefficients': expected 4 or 5 values "
+                            "(k1 k2 p1 p2 [k3]); rational and thin-prism models are not supported");
+  }
+  std::array<double, 5> dist{};
+  for (int i = 0; i < static_cast<int>(d.total()); ++i) dist[i] = d.at<double>(i);
+  CameraCalibration cam;
+  cam.name = "camera";
+  cam.intrinsics = PinholeRadtanCamera(
+      ReadPositiveInt(fs, path, "image_width"), ReadPositiveInt(fs, path, "image_height"),
+      K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2), K.at<double>(1, 2), dist);
+  return cam;
+}
+
+}  // namespace
+
+CameraCalibration LoadCameraCalibration(const std::string& path, const std::string& camera_name) {
+  if (IsOpenCvFileStorage(path)) return LoadOpenCvCamera(path);
+  const Calibration calibration = LoadCalibration(path);
+  if (camera_name.empty()) {
+    if (calibration.cameras.size() != 1) {
+      throw InputError(path + ": holds " + std::to_string(calibration.cameras.size()) +
+                       " cameras: choose one with --camera");
+    }
+    return calibration.cameras.front();
+  }
+  const CameraCalibration* cam = calibration.FindCamera(camera_name);
+  if (cam == nullptr) throw InputError(path + ": no camera named '" + camera_name + "'");
+  return *cam;
+}
+
+}  // namespace auvdock
