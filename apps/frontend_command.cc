@@ -1,4 +1,5 @@
-// auvdock frontend --dataset DIR --out OUTDIR [--dehaze] [--matcher ransac|omnidirectional]
+// auvdock frontend --dataset DIR --out OUTDIR [--dehaze] [--no-tracking]
+//                  [--matcher ransac|omnidirectional]
 //
 // Runs the paper's per-frame pipeline (PaperBaselinePipeline) over every camera frame and
 // writes, flushed frame by frame (a stopped run keeps every frame written before the stop):
@@ -36,6 +37,7 @@ struct FrontendOptions {
   std::string dataset;
   std::string out;
   bool dehaze = false;
+  bool no_tracking = false;
   std::string matcher = "ransac";
   bool quiet = false;
 };
@@ -70,6 +72,7 @@ void RunFrontend(const FrontendOptions& options) {
   }
   PaperBaselineOptions pipeline_options;
   pipeline_options.detector.dehaze = options.dehaze;
+  pipeline_options.use_tracking = !options.no_tracking;
   if (options.matcher == "omnidirectional") {
     pipeline_options.matcher = BaselineMatcher::kOmnidirectional;
   } else if (options.matcher != "ransac") {
@@ -167,6 +170,8 @@ void AddFrontendCommand(CLI::App& root) {
   sub->add_option("--dataset", options->dataset, "Dataset folder")->required();
   sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
   sub->add_flag("--dehaze", options->dehaze, "Dark-channel dehazing before detection");
+  sub->add_flag("--no-tracking", options->no_tracking,
+                "Identify every frame from scratch (the paper's frame-independent matching)");
   sub->add_option("--matcher", options->matcher, "ransac (default) or omnidirectional");
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { RunFrontend(*options); });

@@ -24,7 +24,7 @@ PaperBaselinePipeline::PaperBaselinePipeline(const Calibration& calibration,
 }
 
 std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& camera,
-                                                     CameraObservation* obs) {
+                                                     int64_t t_ns, CameraObservation* obs) {
   obs->light_ids.assign(obs->detections.size(), -1);
   MatchResult match;
   std::optional<Pose3> T_C_D;
@@ -36,6 +36,18 @@ std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& ca
     RansacMatchResult result = MatchRansac(obs->detections, dock_, camera.intrinsics, ransac, rng_);
     T_C_D = result.T_C_D;
     match = result;
+  }
+  const bool recent = last_T_D_B_ && static_cast<double>(t_ns - last_t_ns_) * 1e-9 <=
+                                         options_.tracking_max_age_s;
+  if (match.status != MatchStatus::kOk && options_.use_tracking && recent) {
+    const Pose3 predicted_T_C_D = (*last_T_D_B_ * camera.T_B_C).Inverse();
+    const MatchResult tracked = MatchByPrediction(obs->detections, dock_, camera.intrinsics,
+                                                  predicted_T_C_D, options_.tracking);
+    if (tracked.status == MatchStatus::kOk) {
+      match = tracked;
+      T_C_D = predicted_T_C_D;
+      obs->tracked = true;
+    }
   }
   obs->status = match.status;
   obs->reason = match.reason;
@@ -86,7 +98,9 @@ void PaperBaselinePipeline::MonoPose(const std::optional<Pose3>& T_C_D_initial,
     points.push_back(dock_.FindLight(id)->p_D);
     pixels.push_back(frame->mono.detections[i].uv);
   }
-  if (static_cast<int>(points.size()) < options_.min_mono_lights) return;
+  const int needed = frame->mono.tracked ? std::min(3, options_.min_mono_lights)
+                                         : options_.min_mono_lights;
+  if (static_cast<int>(points.size()) < needed) return;
   PnpOptions pnp;
   pnp.pixel_sigma = mono_->pixel_noise_px;
   const PnpResult result = SolvePnp(points, pixels, mono_->intrinsics, pnp, T_C_D_initial);
@@ -107,9 +121,9 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
   if (have_stereo) {
     frame.left.detections = detector_.Detect(left);
     frame.right.detections = detector_.Detect(right);
-    Identify(*left_, &frame.left);
+    Identify(*left_, t_ns, &frame.left);
     if (frame.left.status != MatchStatus::kOk) {
-      Identify(*right_, &frame.right);
+      Identify(*right_, t_ns, &frame.right);
     } else {
       frame.right.light_ids.assign(frame.right.detections.size(), -1);
       frame.right.status = MatchStatus::kOk;
@@ -118,7 +132,7 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
   }
   if (have_mono) {
     frame.mono.detections = detector_.Detect(mono);
-    const std::optional<Pose3> T_C_D = Identify(*mono_, &frame.mono);
+    const std::optional<Pose3> T_C_D = Identify(*mono_, t_ns, &frame.mono);
     if (frame.mono.status == MatchStatus::kOk) MonoPose(T_C_D, &frame);
   }
 
@@ -139,6 +153,10 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
   } else {
     frame.stage = VisibilityStage::kNeither;
     if (frame.reason.empty()) frame.reason = "no camera sees enough identified lights";
+  }
+  if (frame.T_D_B) {
+    last_T_D_B_ = frame.T_D_B;
+    last_t_ns_ = t_ns;
   }
   return frame;
 }

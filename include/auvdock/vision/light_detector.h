@@ -38,13 +38,16 @@ struct LightDetectorOptions {
   double min_prominence = 6.0;
 
   int min_area_px = 4;
-  double max_area_fraction = 0.25;
+  double max_area_fraction = 0.5;
+  int coarse_scale = 4;
+  int coarse_background_window_cells = 33;
+  double coarse_min_sigma_px = 12.0;
   double max_elongation = 4.0;
-  double min_contrast_per_sigma = 4.6;
-  double min_clipped_contrast_per_sigma = 2.5;
+  double min_contrast_per_sigma = 3.8;
+  double min_clipped_contrast_per_sigma = 0.8;
 
   double min_fit_contrast = 15.0;
-  int max_fit_pixels = 900;
+  int max_fit_pixels = 400;
   double fit_taper_sigmas = 0.6;
   double max_fit_shift_sigmas = 1.5;
   double min_sigma_px = 0.7;

@@ -13,6 +13,12 @@
 //      T_D_S, then T_D_B = T_D_S T_B_S^-1 (S is cam0);
 //   4. mono pose: PnP by Levenberg-Marquardt (SolvePnp, eq. 10) from the matcher's pose:
 //      T_C_D, then T_D_B = T_C_D^-1 T_B_C^-1;
+//   4b. tracking (optional, on by default): when the hypothesise-and-verify matcher cannot
+//      identify an image (too few lights in general position, ambiguity) and the previous
+//      frame's pose is recent, the dock is projected with that pose and the detections are
+//      assigned by gated Hungarian (MatchByPrediction); PnP then starts from the prediction, so
+//      3 identified mono lights suffice. This departs from the paper's frame-independent
+//      matching only where that matching has no answer;
 //   5. stage logic (section 3.1): stereo usable with >= 3 non-collinear triangulated lights,
 //      mono usable with a verified match of >= 4 lights. Stereo only / mono only: that pose.
 //      Both: the paper's post-hoc weighted average, weights by the number of lights each
@@ -35,6 +41,7 @@
 #include "auvdock/vision/light_detector.h"
 #include "auvdock/vision/ransac_matcher.h"
 #include "auvdock/vision/stereo_triangulation.h"
+#include "auvdock/vision/tracking_matcher.h"
 
 namespace auvdock {
 
@@ -46,7 +53,10 @@ struct PaperBaselineOptions {
   RansacMatcherOptions ransac;
   StereoMatchOptions stereo;
   int min_stereo_lights = 3;  // triangulated, non-collinear
-  int min_mono_lights = 4;    // a unique PnP
+  int min_mono_lights = 4;    // a unique PnP (3 when tracking supplies the initial pose)
+  bool use_tracking = true;
+  double tracking_max_age_s = 0.5;  // a previous pose older than this predicts nothing
+  TrackingMatcherOptions tracking;
   uint64_t seed = 1;          // the matcher's random subsets (deterministic)
 };
 
@@ -56,6 +66,7 @@ struct CameraObservation {
   std::vector<int> light_ids;  // per detection: dock light id, or -1 when not identified
   MatchStatus status = MatchStatus::kFailed;
   std::string reason;
+  bool tracked = false;  // identified by prediction (tracking) rather than from scratch
   int num_identified() const;
 };
 
@@ -88,7 +99,8 @@ class PaperBaselinePipeline {
 
  private:
   // Identifies the detections of one image against the dock; returns the matcher's pose.
-  std::optional<Pose3> Identify(const CameraCalibration& camera, CameraObservation* obs);
+  std::optional<Pose3> Identify(const CameraCalibration& camera, int64_t t_ns,
+                                CameraObservation* obs);
   void StereoPose(BaselineFrame* frame);
   void MonoPose(const std::optional<Pose3>& T_C_D_initial, BaselineFrame* frame);
 
@@ -97,6 +109,8 @@ class PaperBaselinePipeline {
   PaperBaselineOptions options_;
   LightDetector detector_;
   std::mt19937_64 rng_;
+  std::optional<Pose3> last_T_D_B_;  // the previous reported pose, for tracking
+  int64_t last_t_ns_ = 0;
   const CameraCalibration* left_ = nullptr;
   const CameraCalibration* right_ = nullptr;
   const CameraCalibration* mono_ = nullptr;
