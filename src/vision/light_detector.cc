@@ -431,13 +431,16 @@ FitResult FitLight(const cv::Mat& image, int channel, const FitStart& start, dou
   // amplitude it must stand above the noise.
   if (!model_reflection || !result.ok || 0.25 * result.amplitude < 3.0 * noise) return result;
   const FitStart refined{result.u, result.v, result.sigma, result.amplitude};
-  const int below = static_cast<int>(std::ceil(3.0 * refined.sigma + 3.0 + 3.0 * 1.6 * refined.sigma));
+  static const double kBelow = std::getenv("AUVDOCK_BELOW") ? std::atof(std::getenv("AUVDOCK_BELOW")) : 7.8;
+  static const double kSide = std::getenv("AUVDOCK_SIDE") ? std::atof(std::getenv("AUVDOCK_SIDE")) : 3.9;
+  const int below = static_cast<int>(std::ceil(kBelow * refined.sigma + 3.0));
+  const int side = static_cast<int>(std::ceil(kSide * refined.sigma)) + 2;
   const int half2 = static_cast<int>(std::ceil(3.0 * refined.sigma)) + 2;
   const int cx2 = static_cast<int>(std::lround(refined.u));
   const int cy2 = static_cast<int>(std::lround(refined.v));
   const std::vector<FitSample> samples =
-      CollectSamples(image, channel, cx2, cy2, cx2 - half2 - below / 2,
-                     cx2 + half2 + below / 2, cy2 - half2, cy2 + below, max_pixels);
+      CollectSamples(image, channel, cx2, cy2, cx2 - side,
+                     cx2 + side, cy2 - half2, cy2 + below, max_pixels);
   if (samples.size() < 20) return result;
   const FitResult two_component = FitModel<14>(samples, refined, noise, 0.0);
   // The second component must be what it is meant to be: a dimmer blob below the light, not the
