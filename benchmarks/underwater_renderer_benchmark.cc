@@ -46,8 +46,8 @@ void BM_RenderFrame(benchmark::State& state) {
   const int width = static_cast<int>(state.range(0));
   const int height = static_cast<int>(state.range(1));
   CameraCalibration camera;
-  camera.intrinsics = PinholeRadtanCamera::FromHorizontalFov(
-      width, height, 70.0 * kPi / 180.0, {-0.05, 0.01, 0.0005, -0.0003, 0.0});
+  camera.intrinsics = PinholeRadtanCamera::FromHorizontalFov(width, height, 70.0 * kPi / 180.0,
+                                                             {-0.05, 0.01, 0.0005, -0.0003, 0.0});
   const UnderwaterRenderer renderer(camera, TDock(), WaterModel::ForType(WaterType::kCoastal),
                                     RenderOptions());
   const Pose3 T_D_C = ViewFromFourMetres();
@@ -63,8 +63,8 @@ BENCHMARK(BM_RenderFrame)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark:
 // Geometric visibility only (what the simulator's visibility stages call per frame).
 void BM_VisibleLights(benchmark::State& state) {
   CameraCalibration camera;
-  camera.intrinsics = PinholeRadtanCamera::FromHorizontalFov(
-      640, 512, 70.0 * kPi / 180.0, {-0.05, 0.01, 0.0005, -0.0003, 0.0});
+  camera.intrinsics = PinholeRadtanCamera::FromHorizontalFov(640, 512, 70.0 * kPi / 180.0,
+                                                             {-0.05, 0.01, 0.0005, -0.0003, 0.0});
   const UnderwaterRenderer renderer(camera, TDock(), WaterModel::ForType(WaterType::kCoastal),
                                     RenderOptions());
   const Pose3 T_D_C = ViewFromFourMetres();

@@ -23,6 +23,14 @@ inline float SoftKnee(float level) {
   const float room = kSceneCeiling - kKneeLevel;
   return kKneeLevel + excess / (1.0f + excess / room);
 }
+
+// The scene is quantized to whole gray levels before the lights, distractors and noise are
+// added: the 8-bit image is then round(scene) + round(light + noise), so a noise-free light's
+// quantization does not depend on where the scene's level sits between two gray levels (a
+// background crossing x.5 under a blob would otherwise round its tails unevenly and shift the
+// centroid by up to ~0.2 px). Levels are non-negative, so truncating level + 0.5 rounds.
+inline float RoundLevel(float level) { return static_cast<float>(static_cast<int>(level + 0.5f)); }
+
 // Lights emit into the half-space above the deck; beyond 85 deg from the vertical the housing
 // hides the emitter.
 const double kCosEmissionHalfAngle = std::cos(85.0 * kPi / 180.0);
@@ -39,24 +47,36 @@ const Eigen::Vector3d kLightColourBgr(0.85, 1.0, 0.2);
 const Eigen::Vector3d kParticleColourBgr(1.0, 1.0, 0.85);
 // Sand/mud is slightly warmer than grey, B G R.
 const Eigen::Vector3f kSeabedTintBgr(0.85f, 1.0f, 1.1f);
+// Each light sits in a dark (black anodised) housing flush with the deck, a disc of this many
+// light radii. Besides being what guide lights look like, it keeps the deck under a saturated
+// light core dark and flat, so clipping does not pull the intensity centroid along the lamp's
+// brightness gradient on the deck.
+constexpr double kHousingRadiusFactor = 4.0;
+constexpr float kHousingAlbedo = 0.04f;
 // The lamp irradiance 1/r^2 is capped at this range (m) so a surface touching the camera stays
 // finite.
 constexpr float kMinLampRangeM = 0.5f;
 
-// Seabed texture: one period of kTexturePeriodM metres in kTextureSize texels (3 cm). The wave
+// Transmission table: exp(-c r) per channel at this many samples per metre, interpolated
+// linearly (relative error below (c / samples)^2 / 8 < 1e-4), out to where every channel is
+// below kMinTransmission; farther surfaces are pure veiling light.
+constexpr double kTransmissionSamplesPerM = 32.0;
+constexpr double kMinTransmission = 1e-4;
+
+// Seabed texture: one period of kTexturePeriodM metres in kTextureSize texels (6 cm; the
+// shortest wave spans 9 texels). 64 KB, so that lookups stay in cache. The wave
 // vectors are whole multiples of 2 pi / period along x and y so the table wraps seamlessly.
-constexpr int kTextureSize = 256;
+constexpr int kTextureSize = 128;
 constexpr double kTexturePeriodM = 8.0;
 struct TextureWave {
   int nx, ny;  // cycles per period along x and y of D
   double amplitude;
   double phase;
 };
-constexpr TextureWave kTextureWaves[] = {
-    {2, 1, 0.08, 0.3},    // 3.6 m ripples
-    {3, -5, 0.07, 1.7},   // 1.4 m
-    {-7, 4, 0.06, 4.1},   // 1.0 m
-    {11, 9, 0.05, 2.6}};  // 0.56 m
+constexpr TextureWave kTextureWaves[] = {{2, 1, 0.10, 0.3},    // 3.6 m sand ripples
+                                         {3, -5, 0.08, 1.7},   // 1.4 m
+                                         {-7, 4, 0.07, 4.1},   // 1.0 m
+                                         {11, 9, 0.05, 2.6}};  // 0.56 m
 
 // Random draws from the caller's generator, written out so that the image does not depend on the
 // standard library's distribution implementations.
@@ -85,6 +105,32 @@ int Poisson(std::mt19937_64& rng, double mean) {
     product *= Uniform01(rng);
   }
   return count;
+}
+
+// Solves DistortNormalized(xy) = distorted for the undistorted normalized point by Newton's
+// method with the analytic Jacobian, starting from *xy. Returns false if it does not converge.
+bool UndistortNewton(const std::array<double, 5>& d, const Eigen::Vector2d& distorted,
+                     Eigen::Vector2d* xy) {
+  const double k1 = d[0], k2 = d[1], p1 = d[2], p2 = d[3], k3 = d[4];
+  for (int iteration = 0; iteration < 12; ++iteration) {
+    const double x = xy->x(), y = xy->y();
+    double xd, yd;
+    DistortNormalized(d, x, y, &xd, &yd);
+    const double rx = xd - distorted.x(), ry = yd - distorted.y();
+    if (rx * rx + ry * ry < 1e-24) return true;
+    const double r2 = x * x + y * y;
+    const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const double dradial_dr2 = k1 + r2 * (2.0 * k2 + 3.0 * k3 * r2);
+    const double j00 = radial + 2.0 * x * x * dradial_dr2 + 2.0 * p1 * y + 6.0 * p2 * x;
+    const double j01 = 2.0 * x * y * dradial_dr2 + 2.0 * p1 * x + 2.0 * p2 * y;
+    const double j10 = 2.0 * x * y * dradial_dr2 + 2.0 * p1 * x + 2.0 * p2 * y;
+    const double j11 = radial + 2.0 * y * y * dradial_dr2 + 6.0 * p1 * y + 2.0 * p2 * x;
+    const double det = j00 * j11 - j01 * j10;
+    if (!(std::fabs(det) > 1e-12)) return false;
+    xy->x() -= (j11 * rx - j01 * ry) / det;
+    xy->y() -= (-j10 * rx + j00 * ry) / det;
+  }
+  return false;
 }
 
 // Adds amplitude_bgr * exp(-|x - uv|^2 / (2 sigma^2)) to a CV_32FC3 image. The support is a disc
@@ -148,16 +194,37 @@ UnderwaterRenderer::UnderwaterRenderer(const CameraCalibration& camera, const Do
   }
   corner_falloff_ = std::max(1e-9, 1.0 - min_cos4);
 
+  // Rays by Newton's method on the distortion, warm-started from the neighbouring pixel (a few
+  // iterations each); the camera's own Unproject is the fallback.
   pixel_rays_.resize(static_cast<size_t>(width) * height * 4);
   float* ray = pixel_rays_.data();
+  Eigen::Vector2d row_start((-intrinsics.cx()) / intrinsics.fx(),
+                            (-intrinsics.cy()) / intrinsics.fy());
   for (int v = 0; v < height; ++v) {
+    Eigen::Vector2d xy = row_start;
     for (int u = 0; u < width; ++u, ray += 4) {
-      const Eigen::Vector3d bearing = intrinsics.Bearing(Eigen::Vector2d(u, v));
+      const Eigen::Vector2d distorted((u - intrinsics.cx()) / intrinsics.fx(),
+                                      (v - intrinsics.cy()) / intrinsics.fy());
+      if (!UndistortNewton(intrinsics.distortion(), distorted, &xy)) {
+        xy = intrinsics.Unproject(Eigen::Vector2d(u, v));
+      }
+      if (u == 0) row_start = xy;
+      const Eigen::Vector3d bearing = Eigen::Vector3d(xy.x(), xy.y(), 1.0).normalized();
       ray[0] = static_cast<float>(bearing.x());
       ray[1] = static_cast<float>(bearing.y());
       ray[2] = static_cast<float>(bearing.z());
       ray[3] = static_cast<float>(kFullScale * options_.exposure * Vignette(bearing.z()));
     }
+  }
+
+  const double min_attenuation = std::max(1e-3, water_.attenuation_per_m.minCoeff());
+  max_surface_range_m_ = std::log(1.0 / kMinTransmission) / min_attenuation;
+  const int num_samples =
+      static_cast<int>(std::ceil(max_surface_range_m_ * kTransmissionSamplesPerM)) + 2;
+  transmission_table_.resize(3 * static_cast<size_t>(num_samples));
+  for (int i = 0; i < num_samples; ++i) {
+    const Eigen::Vector3d t = water_.Transmission(i / kTransmissionSamplesPerM);
+    for (int ch = 0; ch < 3; ++ch) transmission_table_[3 * i + ch] = static_cast<float>(t[ch]);
   }
 
   seabed_texture_.resize(kTextureSize * kTextureSize);
@@ -190,17 +257,20 @@ Eigen::Vector3d UnderwaterRenderer::LightAmplitude(const DockLight& light, doubl
   return gain * kLightColourBgr.cwiseProduct(water_.Transmission(range_m));
 }
 
-float UnderwaterRenderer::SeabedTexture(float x_D, float y_D) const {
+inline float UnderwaterRenderer::SeabedTexture(float x_D, float y_D) const {
   constexpr float kTexelsPerM = static_cast<float>(kTextureSize / kTexturePeriodM);
   const float tx = x_D * kTexelsPerM;
   const float ty = y_D * kTexelsPerM;
-  const float fx = std::floor(tx);
-  const float fy = std::floor(ty);
-  const float ax = tx - fx;
-  const float ay = ty - fy;
-  // Far seabed ranges reach ~150 m: well inside int, and & wraps negatives correctly.
-  const int i0 = static_cast<int>(fx) & (kTextureSize - 1);
-  const int j0 = static_cast<int>(fy) & (kTextureSize - 1);
+  // Floor by truncation (std::floor is a library call without SSE4.1). Far seabed ranges reach
+  // ~150 m: well inside int, and & wraps negatives correctly.
+  int ix = static_cast<int>(tx);
+  int iy = static_cast<int>(ty);
+  ix -= tx < static_cast<float>(ix) ? 1 : 0;
+  iy -= ty < static_cast<float>(iy) ? 1 : 0;
+  const float ax = tx - static_cast<float>(ix);
+  const float ay = ty - static_cast<float>(iy);
+  const int i0 = ix & (kTextureSize - 1);
+  const int j0 = iy & (kTextureSize - 1);
   const int i1 = (i0 + 1) & (kTextureSize - 1);
   const int j1 = (j0 + 1) & (kTextureSize - 1);
   const float* row0 = &seabed_texture_[j0 * kTextureSize];
@@ -246,17 +316,36 @@ void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) co
   const float half_length = static_cast<float>(0.5 * dock_.deck_length_m);
   const float half_width = static_cast<float>(0.5 * dock_.deck_width_m);
   const float seabed_z = static_cast<float>(dock_.deck_height_m);
-  const Eigen::Vector3f c = water_.attenuation_per_m.cast<float>();
   const Eigen::Vector3f A = water_.veiling_light.cast<float>();
   const Eigen::Vector3f ambient = static_cast<float>(options_.ambient_light) * A;
   const float lamp = static_cast<float>(options_.lamp_power);
   const Eigen::Vector3f deck_albedo =
       Eigen::Vector3f::Constant(static_cast<float>(options_.deck_albedo));
-  const Eigen::Vector3f seabed_albedo =
-      static_cast<float>(options_.seabed_albedo) * kSeabedTintBgr;
+  const Eigen::Vector3f seabed_albedo = static_cast<float>(options_.seabed_albedo) * kSeabedTintBgr;
   // Beyond this range every channel's transmission is below 1e-4: the pixel is veiling light.
-  const float max_range = static_cast<float>(std::log(1e4) / std::max(1e-6f, c.minCoeff()));
+  const float max_range = static_cast<float>(max_surface_range_m_);
+  const float samples_per_m = static_cast<float>(kTransmissionSamplesPerM);
   const float min_lamp_range2 = kMinLampRangeM * kMinLampRangeM;
+  // Light housings on the deck: centres and squared radii, plus their common bounding box.
+  struct Housing {
+    float x, y, radius2;
+  };
+  std::vector<Housing> housings;
+  float box_min_x = 0.0f, box_max_x = -1.0f, box_min_y = 0.0f, box_max_y = -1.0f;
+  for (const DockLight& light : dock_.lights) {
+    const float radius = static_cast<float>(kHousingRadiusFactor * light.radius_m);
+    const float x = static_cast<float>(light.p_D.x());
+    const float y = static_cast<float>(light.p_D.y());
+    if (housings.empty()) {
+      box_min_x = x - radius, box_max_x = x + radius, box_min_y = y - radius;
+      box_max_y = y + radius;
+    } else {
+      box_min_x = std::min(box_min_x, x - radius), box_max_x = std::max(box_max_x, x + radius);
+      box_min_y = std::min(box_min_y, y - radius), box_max_y = std::max(box_max_y, y + radius);
+    }
+    housings.push_back({x, y, radius * radius});
+  }
+  const Eigen::Vector3f housing_albedo = Eigen::Vector3f::Constant(kHousingAlbedo);
 
   const float* ray = pixel_rays_.data();
   float* out = image->ptr<float>(0);
@@ -273,9 +362,18 @@ void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) co
         const float s = -oz / dz;
         const float x = ox + s * dx;
         const float y = oy + s * dy;
-        if (std::fabs(x) <= half_length && std::fabs(y) <= half_width) {
+        if (std::fabs(x) <= half_length && std::fabs(y) <= half_width && s < max_range) {
           range = s;
           albedo = deck_albedo;
+          if (x >= box_min_x && x <= box_max_x && y >= box_min_y && y <= box_max_y) {
+            for (const Housing& housing : housings) {
+              const float hx = x - housing.x, hy = y - housing.y;
+              if (hx * hx + hy * hy <= housing.radius2) {
+                albedo = housing_albedo;
+                break;
+              }
+            }
+          }
         }
       }
       if (range < 0.0f && oz < seabed_z) {
@@ -287,18 +385,22 @@ void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) co
       }
     }
     if (range < 0.0f) {
-      out[0] = gain * A[0];
-      out[1] = gain * A[1];
-      out[2] = gain * A[2];
+      out[0] = RoundLevel(gain * A[0]);
+      out[1] = RoundLevel(gain * A[1]);
+      out[2] = RoundLevel(gain * A[2]);
       continue;
     }
     // Lamp at the camera: incidence angle = viewing angle (cos = dz for a horizontal surface),
     // beam cos^2 off the optical axis, inverse square law.
     const float lamp_term = lamp * dz * rz * rz / std::max(range * range, min_lamp_range2);
+    const float sample = range * samples_per_m;
+    const int i = static_cast<int>(sample);
+    const float alpha = sample - static_cast<float>(i);
+    const float* t0 = &transmission_table_[3 * i];
     for (int ch = 0; ch < 3; ++ch) {
-      const float t = std::exp(-c[ch] * range);
+      const float t = t0[ch] + alpha * (t0[ch + 3] - t0[ch]);
       const float J = albedo[ch] * (ambient[ch] + lamp_term * t);
-      out[ch] = SoftKnee(gain * (J * t + A[ch] * (1.0f - t)));
+      out[ch] = RoundLevel(SoftKnee(gain * (J * t + A[ch] * (1.0f - t))));
     }
   }
 }
@@ -342,7 +444,8 @@ RenderResult UnderwaterRenderer::Render(const Pose3& T_D_C, std::mt19937_64& rng
   for (int i = 0; i < num_particles; ++i) {
     RenderedDistractor particle;
     particle.kind = "particle";
-    particle.uv = Eigen::Vector2d(Uniform(rng, -0.5, width - 0.5), Uniform(rng, -0.5, height - 0.5));
+    particle.uv =
+        Eigen::Vector2d(Uniform(rng, -0.5, width - 0.5), Uniform(rng, -0.5, height - 0.5));
     particle.radius_px = Uniform(rng, 0.6, 1.5);
     const double brightness = Uniform(rng, 60.0, 200.0) * options_.exposure;
     AddGaussianBlob(particle.uv, particle.radius_px, brightness * kParticleColourBgr, &image);

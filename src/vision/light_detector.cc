@@ -37,8 +37,16 @@ class CoarseBackground {
     cv::resize(image, coarse, cv::Size(cols_, rows_), 0, 0, cv::INTER_AREA);
     coarse.convertTo(coarse, CV_32F);
     const int w = std::max(1, window_cells);
-    cv::morphologyEx(coarse, coarse, cv::MORPH_OPEN,
-                     cv::getStructuringElement(cv::MORPH_RECT, cv::Size(w, w)));
+    const cv::Mat square = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(w, w));
+    static const int mode = std::getenv("AUVDOCK_BGMODE") ? std::atoi(std::getenv("AUVDOCK_BGMODE")) : 0;
+    if (mode == 1) {
+      cv::morphologyEx(coarse, coarse, cv::MORPH_CLOSE, square);
+      cv::morphologyEx(coarse, coarse, cv::MORPH_OPEN, square);
+    } else if (mode == 2) {
+      cv::Mat c8; coarse.convertTo(c8, CV_8U); cv::medianBlur(c8, c8, w | 1); c8.convertTo(coarse, CV_32F);
+    } else {
+      cv::morphologyEx(coarse, coarse, cv::MORPH_OPEN, square);
+    }
     cv::blur(coarse, coarse, cv::Size(3, 3), cv::Point(-1, -1), cv::BORDER_REPLICATE);
     cv::split(coarse, planes_);
   }
@@ -431,10 +439,10 @@ FitResult FitLight(const cv::Mat& image, int channel, const FitStart& start, dou
   // amplitude it must stand above the noise.
   if (!model_reflection || !result.ok || 0.25 * result.amplitude < 3.0 * noise) return result;
   const FitStart refined{result.u, result.v, result.sigma, result.amplitude};
-  static const double kBelow = std::getenv("AUVDOCK_BELOW") ? std::atof(std::getenv("AUVDOCK_BELOW")) : 7.8;
-  static const double kSide = std::getenv("AUVDOCK_SIDE") ? std::atof(std::getenv("AUVDOCK_SIDE")) : 3.9;
-  const int below = static_cast<int>(std::ceil(kBelow * refined.sigma + 3.0));
-  const int side = static_cast<int>(std::ceil(kSide * refined.sigma)) + 2;
+  // The window reaches 4.5 sigma below the light (most of a reflection a few sigma down) and
+  // 2.5 sigma to the sides; wider, it takes in more background than the quadratic describes.
+  const int below = static_cast<int>(std::ceil(4.5 * refined.sigma + 3.0));
+  const int side = static_cast<int>(std::ceil(2.5 * refined.sigma)) + 2;
   const int half2 = static_cast<int>(std::ceil(3.0 * refined.sigma)) + 2;
   const int cx2 = static_cast<int>(std::lround(refined.u));
   const int cy2 = static_cast<int>(std::lround(refined.v));
@@ -470,6 +478,25 @@ double CentralMean(const cv::Mat& image, int channel, double u, double v, double
     }
   }
   return count > 0 ? sum / count : 0.0;
+}
+
+// True when some channel reaches full scale within the disc of radius max(1, sigma / 2) around
+// (u, v): the blob's own core is clipped.
+bool CoreClipped(const cv::Mat& image, double u, double v, double sigma) {
+  const double radius = std::max(1.0, 0.5 * sigma);
+  const int channels = image.channels();
+  for (int y = std::max(0, static_cast<int>(std::floor(v - radius)));
+       y <= std::min(image.rows - 1, static_cast<int>(std::ceil(v + radius))); ++y) {
+    const uint8_t* row = image.ptr<uint8_t>(y);
+    for (int x = std::max(0, static_cast<int>(std::floor(u - radius)));
+         x <= std::min(image.cols - 1, static_cast<int>(std::ceil(u + radius))); ++x) {
+      if (std::hypot(x - u, y - v) > radius) continue;
+      for (int c = 0; c < channels; ++c) {
+        if (row[channels * x + c] >= kFullScale) return true;
+      }
+    }
+  }
+  return false;
 }
 
 // Red excess over the larger of the blue and green excesses in the core of a small blob (radius
@@ -610,8 +637,8 @@ bool MeasureBlob(const cv::Mat& image, const LightDetectorOptions& options, Blob
   const int f = blob->scale;
   const int small_cols = cols / f;  // width of the blob grid (cv::resize floors)
 
-  // Local background: median of up to ~256 samples on a ring 2-4 pixels (times the scale)
-  // outside the bounding box.
+  // Local background: up to ~256 samples on a ring three pixels (times the scale) outside the
+  // bounding box.
   const int margin = 3 * f;
   const int rx0 = std::max(0, blob->x0 - margin), rx1 = std::min(cols - 1, blob->x1 + margin);
   const int ry0 = std::max(0, blob->y0 - margin), ry1 = std::min(rows - 1, blob->y1 + margin);
@@ -630,11 +657,13 @@ bool MeasureBlob(const cv::Mat& image, const LightDetectorOptions& options, Blob
     sample(rx0, y);
     sample(rx1, y);
   }
+  // The 10th percentile: a ring can cross brighter things (a neighbouring light, a reflection,
+  // the lit deck around a dark light housing); it is the darkest part that is background.
   std::array<double, 3> bg{};
   for (int c = 0; c < channels; ++c) {
     std::vector<uint8_t>& r = ring[c];
-    std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
-    bg[c] = r[r.size() / 2];
+    std::nth_element(r.begin(), r.begin() + r.size() / 10, r.end());
+    bg[c] = r[r.size() / 10];
   }
 
   // Visit the blob's full-resolution pixels (a coarse pixel covers f x f of them).
@@ -660,9 +689,9 @@ bool MeasureBlob(const cv::Mat& image, const LightDetectorOptions& options, Blob
   });
   blob->peak = *std::max_element(peak.begin(), peak.begin() + channels);
 
-  // A channel counts as clipped when a few percent of the blob is at full scale (a particle on
-  // the blob clips a handful of pixels and must not decide).
-  const int clipped_pixels = std::max(3, static_cast<int>(0.02 * count));
+  // A channel counts as clipped when more than a couple of pixels are at full scale (a small
+  // particle on the blob may clip one or two).
+  const int clipped_pixels = 3;
   double best_contrast = 0.0;
   int most_energy = 0;
   for (int c = 0; c < channels; ++c) {
@@ -693,14 +722,17 @@ bool MeasureBlob(const cv::Mat& image, const LightDetectorOptions& options, Blob
   }
   if (channels == 3) blob->red_ratio = energy[2] / std::max({1.0, energy[0], energy[1]});
 
-  // First estimate: centroid of the measuring channel above half its peak; sigma from the
-  // channel's energy (a Gaussian of peak P and sigma s holds 2 pi s^2 P).
+  // First estimate: centroid of the measuring channel above half its peak; sigma from the area
+  // above half the peak (pi 2 ln 2 s^2 for a Gaussian; more for a clipped one, which the fit
+  // corrects).
   const int c = blob->channel;
   const double half_level = bg[c] + 0.5 * blob->channel_contrast[c];
   double sw = 0.0, su = 0.0, sv = 0.0, suu = 0.0, svv = 0.0, suv = 0.0;
+  int half_area = 0;
   for_each_pixel([&](int x, int y, const uint8_t* pixel) {
     const double w = pixel[c] - half_level;
     if (w <= 0.0) return;
+    ++half_area;
     sw += w;
     su += w * x;
     sv += w * y;
@@ -718,7 +750,7 @@ bool MeasureBlob(const cv::Mat& image, const LightDetectorOptions& options, Blob
   const double spread = std::sqrt(0.25 * (cuu - cvv) * (cuu - cvv) + cuv * cuv);
   blob->elongation = std::sqrt((mean + spread) / std::max(1e-6, mean - spread));
   blob->amplitude = std::max(1.0, blob->channel_contrast[c]);
-  blob->sigma = std::sqrt(std::max(0.25, energy[c] / (2.0 * kPi * blob->amplitude)));
+  blob->sigma = std::sqrt(std::max(0.25, half_area / (2.0 * kPi * std::log(2.0))));
   return true;
 }
 
@@ -790,40 +822,9 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
   const double threshold =
       SegmentScale(smoothed, smoothed_noise, 1, options_, options_.background_window_cells,
                    options_.max_area_fraction, cols, rows, &blobs);
-  std::vector<const Blob*> candidates;
-  cv::Mat owner(rows, cols, CV_8U, cv::Scalar(0));  // 1 where a fine-scale candidate lies
-  for (Blob& blob : blobs) {
-    if (!MeasureBlob(image, options_, &blob) || !passes(blob)) continue;
-    candidates.push_back(&blob);
-    for (int index : blob.pixels) owner.data[index] = 1;
-  }
-  // Lights bigger than the background window (the last metre of the landing) are found on a
-  // downsampled image with a wide window; only the big ones are kept from that scale, and only
-  // where the fine scale found nothing.
-  const int f = options_.coarse_scale;
-  std::vector<Blob> coarse_blobs;
-  if (f >= 2 && cols / f >= 16 && rows / f >= 16) {
-    cv::Mat small;
-    cv::resize(smoothed, small, cv::Size(cols / f, rows / f), 0, 0, cv::INTER_AREA);
-    SegmentScale(small, smoothed_noise / f, f, options_, options_.coarse_background_window_cells,
-                 1.0, cols, rows, &coarse_blobs);
-    const double min_sigma = options_.coarse_min_sigma_px * cols / 640.0;
-    for (Blob& blob : coarse_blobs) {
-      if (blob.area < 2.0 * kPi * min_sigma * min_sigma) continue;
-      if (!MeasureBlob(image, options_, &blob) || blob.sigma < min_sigma || !passes(blob)) {
-        continue;
-      }
-      const int x = std::clamp(static_cast<int>(std::lround(blob.u)), 0, cols - 1);
-      const int y = std::clamp(static_cast<int>(std::lround(blob.v)), 0, rows - 1);
-      if (owner.at<uint8_t>(y, x)) continue;
-      candidates.push_back(&blob);
-    }
-  }
-
-  // Fit every candidate at full resolution and check that the fit describes a light.
+  // Fits a candidate at full resolution and keeps it if the fit describes a light.
   std::vector<Light> lights;
-  for (const Blob* candidate : candidates) {
-    const Blob& blob = *candidate;
+  auto fit_and_check = [&](const Blob& blob) {
     const int c = blob.channel;
     const double noise_c = noise_of(c);
     const FitResult fit = FitLight(image, c, {blob.u, blob.v, blob.sigma, blob.amplitude}, noise_c,
@@ -836,7 +837,7 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
     }
     // The coarse scale is there for big lights only.
     if (!fit.ok || (blob.scale > 1 && fit.sigma < 0.5 * options_.coarse_min_sigma_px * cols / 640.0)) {
-      continue;
+      return false;
     }
     Light light;
     light.blob = &blob;
@@ -858,8 +859,7 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
     // scales with the focal length). The brightness is the fit's amplitude (which sees through
     // clipping and ignores a particle on the blob), scaled to the blob's brightest channel; a
     // clipped blob has a lower bar, since clipping leaves its amplitude uncertain.
-    const bool clipped =
-        blob.channel_saturated[0] || blob.channel_saturated[1] || blob.channel_saturated[2];
+    const bool clipped = CoreClipped(image, fit.u, fit.v, fit.sigma);
     const double size = fit.sigma * 640.0 / cols;
     const double min_contrast = (clipped ? options_.min_clipped_contrast_per_sigma
                                          : options_.min_contrast_per_sigma) * size;
@@ -870,7 +870,7 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
     if (central > 2.0 * explained + 3.0 * noise_c || shift > options_.max_fit_shift_sigmas ||
         fit.sigma < options_.min_sigma_px || brightness < min_contrast) {
       if (debug) std::printf("    inconsistent %.1f,%.1f central %.1f explained %.1f shift %.2f maxc %.1f min %.1f\n", fit.u, fit.v, central, explained, shift, light.max_contrast, min_contrast);
-      continue;
+      return false;
     }
     // Particles: small and white (marine snow under the lamp), unlike the blue-green lights,
     // whose red is absorbed long before they look that small.
@@ -878,10 +878,43 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
         fit.sigma <= options_.particle_max_sigma_px &&
         CoreRedRatio(image, fit.u, fit.v, fit.sigma) >= options_.particle_min_red_ratio) {
       if (debug) std::printf("    particle %.1f,%.1f\n", fit.u, fit.v);
-      continue;
+      return false;
     }
     lights.push_back(light);
+    return true;
+  };
+
+  cv::Mat owner(rows, cols, CV_8U, cv::Scalar(0));  // 1 where a fine-scale light was found
+  for (Blob& blob : blobs) {
+    if (!MeasureBlob(image, options_, &blob) || !passes(blob) || !fit_and_check(blob)) continue;
+    for (int index : blob.pixels) owner.data[index] = 1;
   }
+  // Lights bigger than the background window (the last metre of the landing) are found on a
+  // downsampled image with a wide window; only the big ones are kept from that scale, and only
+  // where the fine scale found no light.
+  const int f = options_.coarse_scale;
+  std::vector<Blob> coarse_blobs;
+  if (f >= 2 && cols / f >= 16 && rows / f >= 16) {
+    cv::Mat small;
+    cv::resize(smoothed, small, cv::Size(cols / f, rows / f), 0, 0, cv::INTER_AREA);
+    SegmentScale(small, smoothed_noise / f, f, options_, options_.coarse_background_window_cells,
+                 1.0, cols, rows, &coarse_blobs);
+    const double min_sigma = options_.coarse_min_sigma_px * cols / 640.0;
+    for (Blob& blob : coarse_blobs) {
+      if (debug) std::printf("    coarse blob area %.0f lc %.1f\n", blob.area, blob.luma_contrast);
+      if (blob.area < 2.0 * kPi * min_sigma * min_sigma) continue;
+      const bool measured = MeasureBlob(image, options_, &blob);
+      if (debug) std::printf("    coarse measured %d %.1f,%.1f sigma %.1f el %.2f passes %d\n", measured, blob.u, blob.v, blob.sigma, blob.elongation, passes(blob));
+      if (!measured || blob.sigma < min_sigma || !passes(blob)) {
+        continue;
+      }
+      const int x = std::clamp(static_cast<int>(std::lround(blob.u)), 0, cols - 1);
+      const int y = std::clamp(static_cast<int>(std::lround(blob.v)), 0, rows - 1);
+      if (owner.at<uint8_t>(y, x)) continue;
+      fit_and_check(blob);
+    }
+  }
+
 
   // The same light found twice (by both scales, or as two blobs): keep the first, which comes
   // from the finer scale.
@@ -915,15 +948,17 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
         const double du = std::abs(candidate.u - source.u);
         if (dv < options_.reflection_min_offset_sigmas * s ||
             dv > options_.reflection_max_offset_sigmas * s + options_.reflection_max_offset_px ||
-            du > options_.reflection_max_lateral_sigmas * s + 2.0) {
+            du > options_.reflection_max_lateral_sigmas * s + 3.0) {
           continue;
         }
+        // Dimmer: less light in all (luma energy), or, where the source is not clipped, a lower
+        // peak in the source's measuring channel.
+        const double ratio = options_.reflection_max_ratio;
         const bool dimmer =
-            source.blob->channel_saturated[c]
-                ? candidate.blob->luma_energy <
-                      options_.reflection_max_ratio * source.blob->luma_energy
-                : candidate.blob->channel_contrast[c] <
-                      options_.reflection_max_ratio * source.blob->channel_contrast[c];
+            candidate.blob->luma_energy < ratio * source.blob->luma_energy ||
+            (!source.blob->channel_saturated[c] &&
+             candidate.blob->channel_contrast[c] < ratio * source.blob->channel_contrast[c]);
+        if (debug) std::printf("    pair src %.1f,%.1f s %.2f cand %.1f,%.1f dv/s %.2f du/s %.2f ch %d sat %d cc %.1f/%.1f E %.0f/%.0f -> %d\n", source.u, source.v, s, candidate.u, candidate.v, dv / s, du / s, c, (int)source.blob->channel_saturated[c], candidate.blob->channel_contrast[c], source.blob->channel_contrast[c], candidate.blob->luma_energy, source.blob->luma_energy, (int)dimmer);
         if (dimmer) candidate.rejected = true;
       }
     }

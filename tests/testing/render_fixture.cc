@@ -13,8 +13,8 @@ CameraCalibration MakeRigCamera(int width, int height) {
   CameraCalibration camera;
   camera.name = "cam0";
   camera.role = CameraRole::kStereoLeft;
-  camera.intrinsics = PinholeRadtanCamera::FromHorizontalFov(
-      width, height, 70.0 * kPi / 180.0, {-0.05, 0.01, 0.0005, -0.0003, 0.0});
+  camera.intrinsics = PinholeRadtanCamera::FromHorizontalFov(width, height, 70.0 * kPi / 180.0,
+                                                             {-0.05, 0.01, 0.0005, -0.0003, 0.0});
   camera.rate_hz = 30.0;
   return camera;
 }

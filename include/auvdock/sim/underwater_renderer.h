@@ -11,9 +11,16 @@
 //   J_c = albedo_c (ambient A_c + lamp cos(i) beam t_c(r) / r^2)
 // with a lamp co-located with the camera (so the incidence angle i equals the viewing angle and
 // the light crosses the same water path twice), beam = cos^2 of the angle off the optical axis,
-// and ambient = the share of the veiling light that reaches the bottom as downwelling light. The
+// and ambient = the downwelling daylight on the bottom as a multiple of the veiling light. The
 // seabed albedo carries a low-contrast periodic texture (a sum of four sinusoids in D, period
-// 8 m), so that dehazing and feature extraction have structure to work with; the deck is plain.
+// 8 m), so that dehazing and feature extraction have structure to work with; the deck is plain
+// grey except for a dark housing (a disc of 4 light radii, albedo 0.04) around each light, which
+// keeps the scene under a saturated light core dark and flat. The scene then passes a soft-knee
+// camera response (linear to 140 gray levels, compressed towards 190 above, as an auto-exposed
+// camera keeps a lamp-lit deck out of saturation), is multiplied by the vignetting
+//   v = 1 - vignetting (1 - cos^4 theta) / (1 - cos^4 theta_corner)
+// and is rounded to whole gray levels, so that a light's quantization below does not depend on
+// where the scene level sits between two gray levels.
 //
 // Guide lights are added as isotropic 2-D Gaussian blobs centred exactly at the distorted
 // projection of the light centre p_D_L:
@@ -25,16 +32,22 @@
 // blur spot, which the factor s models (it is ~1 up to ~15 m for a 5 cm light at fx = 457 px and
 // makes the irradiance fall as t/range^2 beyond). The colour is blue-green (cyan LED guide
 // lights). Blobs are added before 8-bit clipping, so a saturated core is a symmetric plateau and
-// the intensity centroid stays on the projection. Vignetting is applied per pixel to the scene
-// but, for lights, as the constant vignette value at the blob centre (a blob is small; a slope
-// across it would bias the centroid). Then reflections (a dimmer, wider copy of each visible
-// light displaced toward the image bottom: its glint on the wet deck / the camera port) and
-// marine-snow particles (Poisson count, uniform position) are added as distractors, then
-// additive Gaussian sensor noise, then rounding and clipping to 8 bit.
+// the intensity centroid stays on the projection (within ~0.12 px of it over the dark housing,
+// noise off, in the tests). Vignetting is applied per pixel to the scene but, for lights, as the
+// constant vignette value at the blob centre (a blob is small; a slope across it would bias the
+// centroid). A light of intensity 0 is never visible: "lights off" keeps the housings. Then
+// reflections (a dimmer, wider copy of each visible light displaced toward the image bottom: its
+// glint on the wet deck / the camera port) and marine-snow particles (Poisson count, uniform
+// position) are added as distractors, then additive Gaussian sensor noise, then rounding and
+// clipping to 8 bit.
 //
 // Frames: T_D_C maps camera coordinates (OpenCV: x right, y down, z optical axis) into the dock
 // frame D (origin on the deck, z down). Units: metres, pixels, 8-bit gray levels; radiances are
 // in full-scale units (1.0 = 255 gray levels at exposure 1).
+//
+// Cost: the rays, vignetting and a per-channel transmission table exp(-c r) are computed once in
+// the constructor; a 640x512 frame takes ~8 ms for the scene plus ~3 ms for the sensor noise on
+// one core.
 //
 // Determinism: every random draw comes from the caller's std::mt19937_64 (the sensor noise via a
 // cv::RNG seeded from it), so equal generator states give byte-identical images. No threads, no
@@ -67,8 +80,11 @@ struct RenderOptions {
   double particles_per_frame = 2.0;  // Poisson mean of bright marine-snow specks
   double seabed_albedo = 0.3;        // Lambertian, mean of the texture
   double deck_albedo = 0.6;          // Lambertian, a light-grey painted platform
-  double lamp_power = 8.0;     // vehicle lamp irradiance at 1 m on its axis, full-scale units
-  double ambient_light = 0.3;  // downwelling light reaching the bottom, as a fraction of A
+  double lamp_power = 3.0;           // vehicle lamp irradiance at 1 m on its axis, full-scale units
+  // Downwelling daylight on the bottom, as a multiple of the veiling light A: a Lambertian bottom
+  // of albedo rho then has radiance rho ambient A. 2 makes the plain deck brighter than open
+  // water and the seabed a little darker, as seen looking down in daylight.
+  double ambient_light = 2.0;
   // A light is visible (and drawn) only when its luma peak above the background reaches this
   // (gray levels). 12 is 6 sigma of the default noise.
   double detection_threshold = 12.0;
@@ -136,6 +152,10 @@ class UnderwaterRenderer {
   // Seabed albedo modulation, kTextureSize^2 texels over one period, wrapped.
   std::vector<float> seabed_texture_;
   double corner_falloff_ = 1.0;  // 1 - cos^4(theta) at the farthest image corner
+  // exp(-c r) per channel (B G R interleaved) sampled along r, and the range beyond which a
+  // surface is invisible (every channel's transmission below 1e-4).
+  std::vector<float> transmission_table_;
+  double max_surface_range_m_ = 0.0;
 };
 
 }  // namespace auvdock

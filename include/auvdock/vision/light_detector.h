@@ -55,9 +55,9 @@ struct LightDetectorOptions {
 
   bool reject_reflections = true;
   double reflection_min_offset_sigmas = 1.0;
-  double reflection_max_offset_sigmas = 5.0;
-  double reflection_max_offset_px = 6.0;
-  double reflection_max_lateral_sigmas = 1.0;
+  double reflection_max_offset_sigmas = 7.0;
+  double reflection_max_offset_px = 8.0;
+  double reflection_max_lateral_sigmas = 1.5;
   double reflection_max_ratio = 0.6;
 
   bool reject_particles = true;
