@@ -6,9 +6,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <numeric>
 #include <stdexcept>
 #include <vector>
+#include <chrono>
 #include <chrono>
 
 #include <Eigen/Dense>
@@ -125,7 +127,8 @@ struct Blob {
   double peak = 0.0;           // raw luma maximum (or of the channels for colour images)
   double area = 0.0;           // full-resolution pixels above the threshold
   std::array<double, 3> channel_contrast{};  // raw maximum - background, per channel
-  std::array<bool, 3> channel_saturated{};   // a few percent of the blob at full scale
+  std::array<bool, 3> channel_saturated{};   // more than a couple of pixels at full scale
+  std::array<double, 3> background{};        // local background per channel
   int channel = 0;             // channel the position is measured in
   double u = 0.0, v = 0.0;     // centroid above half the peak in `channel`, pixels
   double sigma = 0.0;          // Gaussian sigma from energy / peak, pixels
@@ -301,7 +304,14 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
       double w = 1.0;
       if (taper > 0.0 && dy > 0.0) w = std::exp(-0.5 * (dy / taper) * (dy / taper));
       const double position_weight = w;
-      if (r > 0.0) {
+      static const int loss = std::getenv("AUVDOCK_LOSS") ? std::atoi(std::getenv("AUVDOCK_LOSS")) : 0;
+      if (r > 0.0 && loss == 1) {
+        // Geman-McClure: rho = s^2 / 2 z^2 / (1 + z^2), IRLS weight 1 / (1 + z^2)^2.
+        const double z2 = (r / scale) * (r / scale);
+        const double d = 1.0 / (1.0 + z2);
+        w *= d * d;
+        cost += position_weight * 0.5 * scale * scale * z2 * d;
+      } else if (r > 0.0) {
         const double z = r / scale;
         w *= 1.0 / (1.0 + z * z);
         cost += position_weight * 0.5 * scale * scale * std::log1p(z * z);
@@ -344,7 +354,9 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
   Vec jtr;
   double cost = evaluate(theta, &jtj, &jtr, nullptr);
   double lambda = 1e-3;
-  for (int iteration = 0; iteration < 25; ++iteration) {
+  static const int max_iter = std::getenv("AUVDOCK_ITER") ? std::atoi(std::getenv("AUVDOCK_ITER")) : 25;
+  static const double tol = std::getenv("AUVDOCK_TOL") ? std::atof(std::getenv("AUVDOCK_TOL")) : 1e-3;
+  for (int iteration = 0; iteration < max_iter; ++iteration) {
     Mat damped = jtj;
     damped.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-6);
     const Vec step = damped.ldlt().solve(jtr);
@@ -365,7 +377,7 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
       theta = candidate;
       cost = evaluate(theta, &jtj, &jtr, nullptr);
       lambda = std::max(1e-7, lambda * 0.3);
-      if (std::abs(step[0]) < 1e-3 && std::abs(step[1]) < 1e-3) break;
+      if (std::abs(step[0]) < tol && std::abs(step[1]) < tol) break;
     } else {
       lambda *= 10.0;
       if (lambda > 1e6) break;
@@ -572,19 +584,35 @@ double SegmentScale(const cv::Mat& smoothed, double smoothed_noise, int scale,
   const int num_labels = cv::connectedComponents(mask, labels, 8, CV_32S);
   if (num_labels <= 1) return threshold;
 
+  // Pixel lists, bounding boxes and brightest pixel per component, in one pass that skips the
+  // (mostly empty) mask eight bytes at a time.
   std::vector<std::vector<int>> components(num_labels);
   std::vector<std::array<int, 4>> boxes(num_labels, {cols, rows, -1, -1});
+  std::vector<int> brightest(num_labels, -1);
   for (int y = 0; y < rows; ++y) {
+    const uint8_t* m = mask.ptr<uint8_t>(y);
     const int* l = labels.ptr<int>(y);
     for (int x = 0; x < cols; ++x) {
+      if (x + 8 <= cols) {
+        uint64_t chunk;
+        std::memcpy(&chunk, m + x, sizeof(chunk));
+        if (chunk == 0) {
+          x += 7;
+          continue;
+        }
+      }
+      if (m[x] == 0) continue;
       const int label = l[x];
-      if (label == 0) continue;
-      components[label].push_back(y * cols + x);
+      const int index = y * cols + x;
+      components[label].push_back(index);
       std::array<int, 4>& box = boxes[label];
       box[0] = std::min(box[0], x);
       box[1] = std::min(box[1], y);
       box[2] = std::max(box[2], x);
       box[3] = std::max(box[3], y);
+      if (brightest[label] < 0 || smoothed.data[index] > smoothed.data[brightest[label]]) {
+        brightest[label] = index;
+      }
     }
   }
   const size_t max_area = static_cast<size_t>(max_area_fraction * rows * cols);
@@ -593,6 +621,12 @@ double SegmentScale(const cv::Mat& smoothed, double smoothed_noise, int scale,
     const std::vector<int>& component = components[label];
     if (component.size() * scale * scale < static_cast<size_t>(options.min_area_px) ||
         component.size() > max_area) {
+      continue;
+    }
+    // No blob of a component can be brighter than the component's brightest pixel.
+    const int top = brightest[label];
+    if (smoothed.data[top] - background.At(0, top % cols, top / cols) <
+        options.min_peak_contrast) {
       continue;
     }
     const std::array<int, 4>& box = boxes[label];
@@ -643,55 +677,58 @@ bool MeasureBlob(const cv::Mat& image, const LightDetectorOptions& options, Blob
   const int rx0 = std::max(0, blob->x0 - margin), rx1 = std::min(cols - 1, blob->x1 + margin);
   const int ry0 = std::max(0, blob->y0 - margin), ry1 = std::min(rows - 1, blob->y1 + margin);
   const int perimeter = 2 * ((rx1 - rx0) + (ry1 - ry0)) + 4;
-  const int step = std::max(1, perimeter / 256);
+  const int ring_step = std::max(1, perimeter / 256);
   std::array<std::vector<uint8_t>, 3> ring;
   auto sample = [&](int x, int y) {
     const uint8_t* pixel = image.ptr<uint8_t>(y) + channels * x;
     for (int c = 0; c < channels; ++c) ring[c].push_back(pixel[c]);
   };
-  for (int x = rx0; x <= rx1; x += step) {
+  for (int x = rx0; x <= rx1; x += ring_step) {
     sample(x, ry0);
     sample(x, ry1);
   }
-  for (int y = ry0; y <= ry1; y += step) {
+  for (int y = ry0; y <= ry1; y += ring_step) {
     sample(rx0, y);
     sample(rx1, y);
   }
   // The 10th percentile: a ring can cross brighter things (a neighbouring light, a reflection,
   // the lit deck around a dark light housing); it is the darkest part that is background.
-  std::array<double, 3> bg{};
+  std::array<double, 3>& bg = blob->background;
   for (int c = 0; c < channels; ++c) {
     std::vector<uint8_t>& r = ring[c];
     std::nth_element(r.begin(), r.begin() + r.size() / 10, r.end());
     bg[c] = r[r.size() / 10];
   }
 
-  // Visit the blob's full-resolution pixels (a coarse pixel covers f x f of them).
+  // Visit the blob's pixels at full resolution, each standing for `weight` pixels: a coarse pixel
+  // by the centre of its f x f block, and a large fine blob by every k-th pixel of its list
+  // (which is ordered by brightness, so the sample spans all levels and keeps the brightest).
+  constexpr size_t kMaxVisits = 3000;
+  const size_t stride = std::max<size_t>(1, (blob->pixels.size() + kMaxVisits - 1) / kMaxVisits);
+  const double weight = static_cast<double>(stride) * f * f;
   auto for_each_pixel = [&](auto&& visit) {
-    for (int index : blob->pixels) {
-      const int sx = (index % small_cols) * f, sy = (index / small_cols) * f;
-      for (int y = sy; y < std::min(rows, sy + f); ++y) {
-        const uint8_t* row = image.ptr<uint8_t>(y);
-        for (int x = sx; x < std::min(cols, sx + f); ++x) visit(x, y, row + channels * x);
-      }
+    for (size_t i = 0; i < blob->pixels.size(); i += stride) {
+      const int index = blob->pixels[i];
+      const int x = std::min(cols - 1, (index % small_cols) * f + f / 2);
+      const int y = std::min(rows - 1, (index / small_cols) * f + f / 2);
+      visit(x, y, image.ptr<uint8_t>(y) + channels * x);
     }
   };
-  std::array<double, 3> peak{}, energy{};
-  std::array<int, 3> saturated{};
-  int count = 0;
+  std::array<double, 3> peak{}, energy{}, saturated{};
+  double count = 0.0;
   for_each_pixel([&](int, int, const uint8_t* pixel) {
-    ++count;
+    count += weight;
     for (int c = 0; c < channels; ++c) {
       peak[c] = std::max<double>(peak[c], pixel[c]);
-      energy[c] += pixel[c] - bg[c];
-      saturated[c] += pixel[c] >= kSaturatedLevel;
+      energy[c] += weight * (pixel[c] - bg[c]);
+      if (pixel[c] >= kSaturatedLevel) saturated[c] += weight;
     }
   });
   blob->peak = *std::max_element(peak.begin(), peak.begin() + channels);
 
   // A channel counts as clipped when more than a couple of pixels are at full scale (a small
   // particle on the blob may clip one or two).
-  const int clipped_pixels = 3;
+  const double clipped_pixels = 3.0;
   double best_contrast = 0.0;
   int most_energy = 0;
   for (int c = 0; c < channels; ++c) {
@@ -723,16 +760,15 @@ bool MeasureBlob(const cv::Mat& image, const LightDetectorOptions& options, Blob
   if (channels == 3) blob->red_ratio = energy[2] / std::max({1.0, energy[0], energy[1]});
 
   // First estimate: centroid of the measuring channel above half its peak; sigma from the area
-  // above half the peak (pi 2 ln 2 s^2 for a Gaussian; more for a clipped one, which the fit
-  // corrects).
+  // above half the peak (pi 2 ln 2 s^2 for a Gaussian).
   const int c = blob->channel;
   const double half_level = bg[c] + 0.5 * blob->channel_contrast[c];
   double sw = 0.0, su = 0.0, sv = 0.0, suu = 0.0, svv = 0.0, suv = 0.0;
-  int half_area = 0;
+  double half_area = 0.0;
   for_each_pixel([&](int x, int y, const uint8_t* pixel) {
-    const double w = pixel[c] - half_level;
+    const double w = weight * (pixel[c] - half_level);
     if (w <= 0.0) return;
-    ++half_area;
+    half_area += weight;
     sw += w;
     su += w * x;
     sv += w * y;
@@ -749,8 +785,10 @@ bool MeasureBlob(const cv::Mat& image, const LightDetectorOptions& options, Blob
   const double mean = 0.5 * (cuu + cvv);
   const double spread = std::sqrt(0.25 * (cuu - cvv) * (cuu - cvv) + cuv * cuv);
   blob->elongation = std::sqrt((mean + spread) / std::max(1e-6, mean - spread));
+  // A clipped blob's half-level region is wider than 2 ln 2 s^2 by its clipped core: with r^2 =
+  // area / pi, r_half^2 - r_clipped^2 = 2 ln 2 s^2 whatever the hidden amplitude.
   blob->amplitude = std::max(1.0, blob->channel_contrast[c]);
-  blob->sigma = std::sqrt(std::max(0.25, half_area / (2.0 * kPi * std::log(2.0))));
+  blob->sigma = std::sqrt(std::max(0.25, (half_area - saturated[c]) / (2.0 * kPi * std::log(2.0))));
   return true;
 }
 
@@ -759,8 +797,35 @@ struct Light {
   const Blob* blob = nullptr;
   double u = 0.0, v = 0.0, sigma = 0.0, amplitude = 0.0, rms = 0.0;
   double max_contrast = 0.0;
+  std::array<double, 3> core{};        // per channel: mean of the central disc - background
+  std::array<bool, 3> core_clipped{};  // per channel: the central disc reaches full scale
   bool rejected = false;
 };
+
+// Per-channel mean over the disc of radius max(1, sigma / 2) around (u, v), and whether the disc
+// reaches full scale.
+void CentralDisc(const cv::Mat& image, double u, double v, double sigma,
+                 std::array<double, 3>* mean, std::array<bool, 3>* clipped) {
+  const double radius = std::max(1.0, 0.5 * sigma);
+  const int channels = image.channels();
+  std::array<double, 3> sum{};
+  int count = 0;
+  *clipped = {false, false, false};
+  for (int y = std::max(0, static_cast<int>(std::floor(v - radius)));
+       y <= std::min(image.rows - 1, static_cast<int>(std::ceil(v + radius))); ++y) {
+    const uint8_t* row = image.ptr<uint8_t>(y);
+    for (int x = std::max(0, static_cast<int>(std::floor(u - radius)));
+         x <= std::min(image.cols - 1, static_cast<int>(std::ceil(u + radius))); ++x) {
+      if (std::hypot(x - u, y - v) > radius) continue;
+      ++count;
+      for (int c = 0; c < channels; ++c) {
+        sum[c] += row[channels * x + c];
+        if (row[channels * x + c] >= kFullScale) (*clipped)[c] = true;
+      }
+    }
+  }
+  for (int c = 0; c < channels; ++c) (*mean)[c] = count > 0 ? sum[c] / count : 0.0;
+}
 
 }  // namespace
 
@@ -779,6 +844,10 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
   const int cols = image.cols;
   const int channels = image.channels();
 
+  using Clock = std::chrono::steady_clock;
+  static double acc[8] = {0}; static int ncalls = 0; static double t_fit = 0;
+  auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
+  const auto T0 = Clock::now();
   cv::Mat luma;
   if (channels == 3) {
     cv::cvtColor(image, luma, cv::COLOR_BGR2GRAY);
@@ -818,6 +887,7 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
     return true;
   };
 
+  const auto T1 = Clock::now();
   std::vector<Blob> blobs;
   const double threshold =
       SegmentScale(smoothed, smoothed_noise, 1, options_, options_.background_window_cells,
@@ -827,9 +897,11 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
   auto fit_and_check = [&](const Blob& blob) {
     const int c = blob.channel;
     const double noise_c = noise_of(c);
+    const auto F0 = Clock::now();
     const FitResult fit = FitLight(image, c, {blob.u, blob.v, blob.sigma, blob.amplitude}, noise_c,
                                    options_.max_fit_pixels, options_.fit_taper_sigmas,
                                    options_.model_reflections);
+    t_fit += ms(F0, Clock::now());
     if (debug) {
       std::printf("    fit scale %d ch %d: %.2f,%.2f s %.2f A %.1f -> ok %d %.2f,%.2f s %.2f A %.1f rms %.2f refl %.2f,%.2f s %.2f A %.1f\n",
                   blob.scale, c, blob.u, blob.v, blob.sigma, blob.amplitude, fit.ok, fit.u, fit.v,
@@ -866,9 +938,11 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
     const double brightness =
         fit.amplitude * std::max(1.0, light.max_contrast / std::max(1.0, blob.channel_contrast[c]));
     static const bool featq = std::getenv("AUVDOCK_FEATQ") != nullptr;
-    if (featq) std::printf("FEATQ %.3f %.3f q %.2f clipped %d sigma %.2f A %.1f maxc %.1f cc %.1f scale %d\n", fit.u, fit.v, brightness / size, (int)clipped, fit.sigma, fit.amplitude, light.max_contrast, blob.channel_contrast[c], blob.scale);
+    if (featq) std::printf("FEATQ %.3f %.3f q %.2f clipped %d sigma %.2f A %.1f maxc %.1f cc %.1f scale %d rmsn %.2f border %d area %.0f shift %.2f\n", fit.u, fit.v, brightness / size, (int)clipped, fit.sigma, fit.amplitude, light.max_contrast, blob.channel_contrast[c], blob.scale, fit.rms / noise_c, (int)blob.at_border, blob.area, shift);
+    const bool too_big_unclipped =
+        !clipped && options_.max_unclipped_sigma_px > 0.0 && size > options_.max_unclipped_sigma_px;
     if (central > 2.0 * explained + 3.0 * noise_c || shift > options_.max_fit_shift_sigmas ||
-        fit.sigma < options_.min_sigma_px || brightness < min_contrast) {
+        fit.sigma < options_.min_sigma_px || brightness < min_contrast || too_big_unclipped) {
       if (debug) std::printf("    inconsistent %.1f,%.1f central %.1f explained %.1f shift %.2f maxc %.1f min %.1f\n", fit.u, fit.v, central, explained, shift, light.max_contrast, min_contrast);
       return false;
     }
@@ -880,15 +954,22 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
       if (debug) std::printf("    particle %.1f,%.1f\n", fit.u, fit.v);
       return false;
     }
+    CentralDisc(image, fit.u, fit.v, fit.sigma, &light.core, &light.core_clipped);
+    for (int k = 0; k < channels; ++k) light.core[k] -= blob.background[k];
     lights.push_back(light);
     return true;
   };
 
+  const auto T2 = Clock::now();
   cv::Mat owner(rows, cols, CV_8U, cv::Scalar(0));  // 1 where a fine-scale light was found
   for (Blob& blob : blobs) {
-    if (!MeasureBlob(image, options_, &blob) || !passes(blob) || !fit_and_check(blob)) continue;
+    if (blob.luma_contrast < options_.min_peak_contrast || blob.area < options_.min_area_px ||
+        !MeasureBlob(image, options_, &blob) || !passes(blob) || !fit_and_check(blob)) {
+      continue;
+    }
     for (int index : blob.pixels) owner.data[index] = 1;
   }
+  const auto T3 = Clock::now();
   // Lights bigger than the background window (the last metre of the landing) are found on a
   // downsampled image with a wide window; only the big ones are kept from that scale, and only
   // where the fine scale found no light.
@@ -902,7 +983,10 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
     const double min_sigma = options_.coarse_min_sigma_px * cols / 640.0;
     for (Blob& blob : coarse_blobs) {
       if (debug) std::printf("    coarse blob area %.0f lc %.1f\n", blob.area, blob.luma_contrast);
-      if (blob.area < 2.0 * kPi * min_sigma * min_sigma) continue;
+      if (blob.area < 2.0 * kPi * min_sigma * min_sigma ||
+          blob.luma_contrast < options_.min_peak_contrast) {
+        continue;
+      }
       const bool measured = MeasureBlob(image, options_, &blob);
       if (debug) std::printf("    coarse measured %d %.1f,%.1f sigma %.1f el %.2f passes %d\n", measured, blob.u, blob.v, blob.sigma, blob.elongation, passes(blob));
       if (!measured || blob.sigma < min_sigma || !passes(blob)) {
@@ -916,6 +1000,9 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
   }
 
 
+  const auto T4 = Clock::now();
+  acc[0] += ms(T0, T1); acc[1] += ms(T1, T2); acc[2] += ms(T2, T3); acc[3] += ms(T3, T4); ++ncalls;
+  if (std::getenv("AUVDOCK_TIMING") && ncalls % 600 == 0) std::printf("pre %.3f segfine %.3f measure+fit fine %.3f (fit %.3f) coarse %.3f\n", acc[0] / ncalls, acc[1] / ncalls, acc[2] / ncalls, t_fit / ncalls, acc[3] / ncalls);
   // The same light found twice (by both scales, or as two blobs): keep the first, which comes
   // from the finer scale.
   for (size_t i = 0; i < lights.size(); ++i) {
@@ -951,14 +1038,18 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
             du > options_.reflection_max_lateral_sigmas * s + 3.0) {
           continue;
         }
-        // Dimmer: less light in all (luma energy), or, where the source is not clipped, a lower
-        // peak in the source's measuring channel.
-        const double ratio = options_.reflection_max_ratio;
-        const bool dimmer =
-            candidate.blob->luma_energy < ratio * source.blob->luma_energy ||
-            (!source.blob->channel_saturated[c] &&
-             candidate.blob->channel_contrast[c] < ratio * source.blob->channel_contrast[c]);
-        if (debug) std::printf("    pair src %.1f,%.1f s %.2f cand %.1f,%.1f dv/s %.2f du/s %.2f ch %d sat %d cc %.1f/%.1f E %.0f/%.0f -> %d\n", source.u, source.v, s, candidate.u, candidate.v, dv / s, du / s, c, (int)source.blob->channel_saturated[c], candidate.blob->channel_contrast[c], source.blob->channel_contrast[c], candidate.blob->luma_energy, source.blob->luma_energy, (int)dimmer);
+        // Dimmer: a fainter core in the source's measuring channel; where that channel clips at
+        // the source's core, unclipped in some channel in which the source clips (a nearer
+        // light below a clipped one clips too).
+        bool dimmer = false;
+        if (!source.core_clipped[c]) {
+          dimmer = candidate.core[c] < options_.reflection_max_ratio * source.core[c];
+        } else {
+          for (int k = 0; k < channels; ++k) {
+            if (source.core_clipped[k] && !candidate.core_clipped[k]) dimmer = true;
+          }
+        }
+        if (debug) std::printf("    pair src %.1f,%.1f s %.2f cand %.1f,%.1f dv/s %.2f du/s %.2f ch %d clip %d core %.1f/%.1f -> %d\n", source.u, source.v, s, candidate.u, candidate.v, dv / s, du / s, c, (int)source.core_clipped[c], candidate.core[c], source.core[c], (int)dimmer);
         if (dimmer) candidate.rejected = true;
       }
     }

@@ -45,11 +45,12 @@ struct LightDetectorOptions {
   double max_elongation = 4.0;
   double min_contrast_per_sigma = 3.8;
   double min_clipped_contrast_per_sigma = 0.8;
+  double max_unclipped_sigma_px = 10.0;
 
   double min_fit_contrast = 15.0;
   int max_fit_pixels = 400;
   double fit_taper_sigmas = 0.6;
-  double max_fit_shift_sigmas = 1.5;
+  double max_fit_shift_sigmas = 0.8;
   double min_sigma_px = 0.7;
   bool model_reflections = true;
 
