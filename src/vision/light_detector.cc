@@ -4,14 +4,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <numeric>
 #include <stdexcept>
 #include <vector>
-#include <chrono>
-#include <chrono>
 
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
@@ -40,15 +36,7 @@ class CoarseBackground {
     coarse.convertTo(coarse, CV_32F);
     const int w = std::max(1, window_cells);
     const cv::Mat square = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(w, w));
-    static const int mode = std::getenv("AUVDOCK_BGMODE") ? std::atoi(std::getenv("AUVDOCK_BGMODE")) : 0;
-    if (mode == 1) {
-      cv::morphologyEx(coarse, coarse, cv::MORPH_CLOSE, square);
-      cv::morphologyEx(coarse, coarse, cv::MORPH_OPEN, square);
-    } else if (mode == 2) {
-      cv::Mat c8; coarse.convertTo(c8, CV_8U); cv::medianBlur(c8, c8, w | 1); c8.convertTo(coarse, CV_32F);
-    } else {
-      cv::morphologyEx(coarse, coarse, cv::MORPH_OPEN, square);
-    }
+    cv::morphologyEx(coarse, coarse, cv::MORPH_OPEN, square);
     cv::blur(coarse, coarse, cv::Size(3, 3), cv::Point(-1, -1), cv::BORDER_REPLICATE);
     cv::split(coarse, planes_);
   }
@@ -79,12 +67,12 @@ class CoarseBackground {
 // Robust sigma of the per-pixel noise in one channel: differences of horizontal neighbours are
 // noise times sqrt(2) plus the (small, sparse) image structure; their mean absolute value, with
 // differences above a cap left out as structure, gives sigma = E|d| / (sqrt(2) sqrt(2 / pi)).
-// Every fourth row is enough.
+// Every eighth row is enough.
 double EstimateNoiseSigma(const cv::Mat& image, int channel) {
   constexpr int kCap = 12;  // gray levels
   const int channels = image.channels();
   std::array<int64_t, kCap + 1> histogram{};
-  for (int y = 1; y < image.rows; y += 4) {
+  for (int y = 1; y < image.rows; y += 8) {
     const uint8_t* row = image.ptr<uint8_t>(y) + channel;
     for (int x = 1; x < image.cols; ++x) {
       const int d = std::abs(static_cast<int>(row[channels * x]) -
@@ -123,15 +111,15 @@ struct Blob {
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // bounding box at full resolution, inclusive
   bool at_border = false;
   double luma_contrast = 0.0;  // smoothed luma - background at the brightest pixel
-  double luma_energy = 0.0;    // sum of luma - background, gray levels x full-res pixels
-  double peak = 0.0;           // raw luma maximum (or of the channels for colour images)
+  double luma_energy = 0.0;    // sum of smoothed luma - background, gray levels x pixels
+  double peak = 0.0;           // raw maximum over the blob and its channels, 0-255
   double area = 0.0;           // full-resolution pixels above the threshold
   std::array<double, 3> channel_contrast{};  // raw maximum - background, per channel
   std::array<bool, 3> channel_saturated{};   // more than a couple of pixels at full scale
   std::array<double, 3> background{};        // local background per channel
   int channel = 0;             // channel the position is measured in
   double u = 0.0, v = 0.0;     // centroid above half the peak in `channel`, pixels
-  double sigma = 0.0;          // Gaussian sigma from energy / peak, pixels
+  double sigma = 0.0;          // Gaussian sigma from the area above half the peak, pixels
   double amplitude = 0.0;      // peak above background in `channel`
   double elongation = 1.0;     // sqrt of the ratio of the principal second moments
   double red_ratio = 0.0;      // red excess / max(blue, green) excess
@@ -158,22 +146,32 @@ void SplitComponent(const cv::Mat& smoothed, const std::vector<int>& component, 
     const int x = index % cols - bx;
     const int y = index / cols - by;
     const int level = data[index];
-    std::array<int, 8> roots;
-    int num_roots = 0;
+    // Regions of the already visited neighbours (only this component's pixels are ever
+    // visited, so an id >= 0 means "same component"); neighbours mostly share one id, so the
+    // ids are deduplicated before their roots are looked up.
+    std::array<int, 8> ids;
+    int num_ids = 0;
     for (int dy = -1; dy <= 1; ++dy) {
       const int yy = y + dy;
       if (yy < 0 || yy >= bh) continue;
+      const int* row = &region_of[yy * bw];
       for (int dx = -1; dx <= 1; ++dx) {
         const int xx = x + dx;
         if ((dx == 0 && dy == 0) || xx < 0 || xx >= bw) continue;
-        // Only this component's pixels are ever visited, so r >= 0 means "same component".
-        const int r = region_of[yy * bw + xx];
-        if (r < 0) continue;
-        const int root = FindRoot(regions, r);
-        if (std::find(roots.begin(), roots.begin() + num_roots, root) ==
-            roots.begin() + num_roots) {
-          roots[num_roots++] = root;
+        const int r = row[xx];
+        if (r < 0 || (num_ids > 0 && ids[num_ids - 1] == r)) continue;
+        if (std::find(ids.begin(), ids.begin() + num_ids, r) == ids.begin() + num_ids) {
+          ids[num_ids++] = r;
         }
+      }
+    }
+    std::array<int, 8> roots;
+    int num_roots = 0;
+    for (int k = 0; k < num_ids; ++k) {
+      const int root = FindRoot(regions, ids[k]);
+      if (std::find(roots.begin(), roots.begin() + num_roots, root) ==
+          roots.begin() + num_roots) {
+        roots[num_roots++] = root;
       }
     }
     int& mine = region_of[y * bw + x];
@@ -195,9 +193,11 @@ void SplitComponent(const cv::Mat& smoothed, const std::vector<int>& component, 
     mine = winner;
   }
 
+  std::vector<int> root_of(regions.size());
+  for (size_t r = 0; r < regions.size(); ++r) root_of[r] = FindRoot(regions, static_cast<int>(r));
   std::vector<int> blob_of_root(regions.size(), -1);
   for (int index : order) {
-    const int root = FindRoot(regions, region_of[(index / cols - by) * bw + index % cols - bx]);
+    const int root = root_of[region_of[(index / cols - by) * bw + index % cols - bx]];
     if (blob_of_root[root] < 0) {
       blob_of_root[root] = static_cast<int>(blobs->size());
       blobs->emplace_back();
@@ -206,15 +206,18 @@ void SplitComponent(const cv::Mat& smoothed, const std::vector<int>& component, 
   }
 }
 
-// Robust least-squares fit of an isotropic Gaussian on a local plane to one channel around a
-// blob, optionally with a second, "reflection" Gaussian below it:
-//   m(x, y) = bg(x, y) + b0 + bx (x - u0) + by (y - v0) + A g(x, y; u, v, s)
-//             [+ A_r g(x, y; u_r, v_r, s_r)],   g = exp(-((x - u)^2 + (y - v)^2) / (2 s^2))
-// bg is the coarse background. Clipped pixels (value 255) only say m >= 255: they have no
-// residual when the model agrees. Residuals where the image is brighter than the model (other
-// light added on top: a reflection, a neighbouring light, a particle) are down-weighted by a
-// Cauchy loss; residuals where it is darker are plain least squares, since nothing in the scene
-// subtracts light. Levenberg-Marquardt on (u, v, log s, A, b0, bx, by [, u_r, v_r, log s_r, A_r]).
+// Robust least-squares fit of an isotropic Gaussian on a local quadratic background to one
+// channel around a blob, optionally with a second, "reflection" Gaussian below it:
+//   m(x, y) = q(x, y) + A g(x, y; u, v, s) [+ A_r g(x, y; u_r, v_r, s_r)],
+//   g = exp(-((x - u)^2 + (y - v)^2) / (2 s^2)),  q a quadratic in (x - u0, y - v0) / s0.
+// Clipped pixels (value 255) only say m >= 255: they have no residual when the model agrees.
+// Residuals where the image is brighter than the model (other light added on top: a reflection,
+// a neighbouring light, a particle) are down-weighted by a Geman-McClure loss of scale
+// max(3 noise, A / 20); residuals where it is darker are plain least squares, since nothing in the
+// scene subtracts light. Without the reflection term, samples below the light (where its
+// reflection lies) can be down-weighted by a Gaussian taper of taper_sigmas * s. Levenberg-
+// Marquardt on (u, v, log s, A, 6 background coefficients [, u_r, v_r, log s_r, A_r]), the
+// reflection kept below the light, wider and dimmer by projection after each step.
 struct FitResult {
   bool ok = false;
   double u = 0.0, v = 0.0, sigma = 0.0, amplitude = 0.0, rms = 0.0;
@@ -233,7 +236,7 @@ struct FitStart {
 
 template <int kParams>
 FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start, double noise,
-                   double taper_sigmas) {
+                   double taper_sigmas, int max_iterations) {
   static_assert(kParams == 10 || kParams == 14, "light, or light + reflection");
   constexpr bool kReflection = kParams == 14;
   constexpr int kR = 10;  // first reflection parameter
@@ -286,7 +289,7 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
     for (const FitSample& q : samples) {
       const double dx = q.x - u, dy = q.y - v;
       const double r2 = dx * dx + dy * dy;
-      const double g = std::exp(-0.5 * r2 * inv_s2);
+      const double g = std::exp(static_cast<float>(-0.5 * r2 * inv_s2));
       const double qx = (q.x - u0) * inv_s0, qy = (q.y - v0) * inv_s0;
       double model = p[4] + p[5] * qx + p[6] * qy + p[7] * qx * qx + p[8] * qx * qy +
                      p[9] * qy * qy + a * g;
@@ -295,7 +298,7 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
         dxr = q.x - ur;
         dyr = q.y - vr;
         rr2 = dxr * dxr + dyr * dyr;
-        gr = std::exp(-0.5 * rr2 * inv_sr2);
+        gr = std::exp(static_cast<float>(-0.5 * rr2 * inv_sr2));
         model += ar * gr;
       }
       if (q.clipped && model >= kFullScale) continue;
@@ -304,17 +307,12 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
       double w = 1.0;
       if (taper > 0.0 && dy > 0.0) w = std::exp(-0.5 * (dy / taper) * (dy / taper));
       const double position_weight = w;
-      static const int loss = std::getenv("AUVDOCK_LOSS") ? std::atoi(std::getenv("AUVDOCK_LOSS")) : 0;
-      if (r > 0.0 && loss == 1) {
-        // Geman-McClure: rho = s^2 / 2 z^2 / (1 + z^2), IRLS weight 1 / (1 + z^2)^2.
+      if (r > 0.0) {
+        // Geman-McClure: rho = s^2 z^2 / (2 (1 + z^2)), IRLS weight 1 / (1 + z^2)^2.
         const double z2 = (r / scale) * (r / scale);
         const double d = 1.0 / (1.0 + z2);
         w *= d * d;
         cost += position_weight * 0.5 * scale * scale * z2 * d;
-      } else if (r > 0.0) {
-        const double z = r / scale;
-        w *= 1.0 / (1.0 + z * z);
-        cost += position_weight * 0.5 * scale * scale * std::log1p(z * z);
       } else {
         cost += position_weight * 0.5 * r * r;
       }
@@ -350,13 +348,13 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
     return cost;
   };
 
-  Mat jtj;
-  Vec jtr;
+  // Levenberg-Marquardt where a trial point is evaluated with its Jacobian at once: accepted,
+  // its normal equations are ready for the next step; rejected, only the damping changes.
+  Mat jtj, trial_jtj;
+  Vec jtr, trial_jtr;
   double cost = evaluate(theta, &jtj, &jtr, nullptr);
   double lambda = 1e-3;
-  static const int max_iter = std::getenv("AUVDOCK_ITER") ? std::atoi(std::getenv("AUVDOCK_ITER")) : 25;
-  static const double tol = std::getenv("AUVDOCK_TOL") ? std::atof(std::getenv("AUVDOCK_TOL")) : 1e-3;
-  for (int iteration = 0; iteration < max_iter; ++iteration) {
+  for (int iteration = 0; iteration < max_iterations; ++iteration) {
     Mat damped = jtj;
     damped.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-6);
     const Vec step = damped.ldlt().solve(jtr);
@@ -372,12 +370,14 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
       candidate[kR + 2] = std::clamp(candidate[kR + 2], candidate[2], candidate[2] + std::log(2.5));
       candidate[kR + 3] = std::clamp(candidate[kR + 3], 0.0, std::max(0.0, candidate[3]));
     }
-    const double candidate_cost = evaluate(candidate, nullptr, nullptr, nullptr);
+    const double candidate_cost = evaluate(candidate, &trial_jtj, &trial_jtr, nullptr);
     if (candidate_cost < cost) {
       theta = candidate;
-      cost = evaluate(theta, &jtj, &jtr, nullptr);
+      cost = candidate_cost;
+      jtj = trial_jtj;
+      jtr = trial_jtr;
       lambda = std::max(1e-7, lambda * 0.3);
-      if (std::abs(step[0]) < tol && std::abs(step[1]) < tol) break;
+      if (std::abs(step[0]) < 5e-3 && std::abs(step[1]) < 5e-3) break;
     } else {
       lambda *= 10.0;
       if (lambda > 1e6) break;
@@ -435,8 +435,10 @@ std::vector<FitSample> CollectSamples(const cv::Mat& image, int channel, int cx,
   return samples;
 }
 
-FitResult FitLight(const cv::Mat& image, int channel, const FitStart& start, double noise, int max_pixels, double taper_sigmas,
-                   bool model_reflection) {
+// Fits a light (FitModel<10>, tapered below), then, if it is bright enough for a reflection to
+// show, refits with the reflection term in a window reaching below it (FitModel<14>).
+FitResult FitLight(const cv::Mat& image, int channel, const FitStart& start, double noise,
+                   int max_pixels, double taper_sigmas, bool model_reflection) {
   const int cx = static_cast<int>(std::lround(start.u));
   const int cy = static_cast<int>(std::lround(start.v));
   const int half = static_cast<int>(std::ceil(3.0 * start.sigma)) + 2;
@@ -445,7 +447,8 @@ FitResult FitLight(const cv::Mat& image, int channel, const FitStart& start, dou
     const std::vector<FitSample> samples = CollectSamples(
         image, channel, cx, cy, cx - half, cx + half, cy - half, cy + half, max_pixels);
     if (samples.size() < 12) return result;
-    result = FitModel<10>(samples, start, noise, taper_sigmas);
+    // Only a starting point when the reflection model follows.
+    result = FitModel<10>(samples, start, noise, taper_sigmas, model_reflection ? 8 : 15);
   }
   // A reflection is worth modelling only where it can show: at a quarter of the light's
   // amplitude it must stand above the noise.
@@ -458,11 +461,10 @@ FitResult FitLight(const cv::Mat& image, int channel, const FitStart& start, dou
   const int half2 = static_cast<int>(std::ceil(3.0 * refined.sigma)) + 2;
   const int cx2 = static_cast<int>(std::lround(refined.u));
   const int cy2 = static_cast<int>(std::lround(refined.v));
-  const std::vector<FitSample> samples =
-      CollectSamples(image, channel, cx2, cy2, cx2 - side,
-                     cx2 + side, cy2 - half2, cy2 + below, max_pixels);
+  const std::vector<FitSample> samples = CollectSamples(
+      image, channel, cx2, cy2, cx2 - side, cx2 + side, cy2 - half2, cy2 + below, max_pixels);
   if (samples.size() < 20) return result;
-  const FitResult two_component = FitModel<14>(samples, refined, noise, 0.0);
+  const FitResult two_component = FitModel<14>(samples, refined, noise, 0.0, 15);
   // The second component must be what it is meant to be: a dimmer blob below the light, not the
   // light itself (the fit can swap the two).
   const bool plausible = two_component.ok &&
@@ -473,42 +475,29 @@ FitResult FitLight(const cv::Mat& image, int channel, const FitStart& start, dou
   return plausible ? two_component : result;
 }
 
-// Mean of one channel over the disc of radius max(1, sigma / 2) around (u, v).
-double CentralMean(const cv::Mat& image, int channel, double u, double v, double sigma) {
+// Per-channel mean over the disc of radius max(1, sigma / 2) around (u, v), and whether the disc
+// reaches full scale.
+void CentralDisc(const cv::Mat& image, double u, double v, double sigma,
+                 std::array<double, 3>* mean, std::array<bool, 3>* clipped) {
   const double radius = std::max(1.0, 0.5 * sigma);
   const int channels = image.channels();
-  double sum = 0.0;
+  std::array<double, 3> sum{};
   int count = 0;
+  *clipped = {false, false, false};
   for (int y = std::max(0, static_cast<int>(std::floor(v - radius)));
        y <= std::min(image.rows - 1, static_cast<int>(std::ceil(v + radius))); ++y) {
     const uint8_t* row = image.ptr<uint8_t>(y);
     for (int x = std::max(0, static_cast<int>(std::floor(u - radius)));
          x <= std::min(image.cols - 1, static_cast<int>(std::ceil(u + radius))); ++x) {
       if (std::hypot(x - u, y - v) > radius) continue;
-      sum += row[channels * x + channel];
       ++count;
-    }
-  }
-  return count > 0 ? sum / count : 0.0;
-}
-
-// True when some channel reaches full scale within the disc of radius max(1, sigma / 2) around
-// (u, v): the blob's own core is clipped.
-bool CoreClipped(const cv::Mat& image, double u, double v, double sigma) {
-  const double radius = std::max(1.0, 0.5 * sigma);
-  const int channels = image.channels();
-  for (int y = std::max(0, static_cast<int>(std::floor(v - radius)));
-       y <= std::min(image.rows - 1, static_cast<int>(std::ceil(v + radius))); ++y) {
-    const uint8_t* row = image.ptr<uint8_t>(y);
-    for (int x = std::max(0, static_cast<int>(std::floor(u - radius)));
-         x <= std::min(image.cols - 1, static_cast<int>(std::ceil(u + radius))); ++x) {
-      if (std::hypot(x - u, y - v) > radius) continue;
       for (int c = 0; c < channels; ++c) {
-        if (row[channels * x + c] >= kFullScale) return true;
+        sum[c] += row[channels * x + c];
+        if (row[channels * x + c] >= kFullScale) (*clipped)[c] = true;
       }
     }
   }
-  return false;
+  for (int c = 0; c < channels; ++c) (*mean)[c] = count > 0 ? sum[c] / count : 0.0;
 }
 
 // Red excess over the larger of the blue and green excesses in the core of a small blob (radius
@@ -555,7 +544,7 @@ double CoreRedRatio(const cv::Mat& image, double u, double v, double sigma) {
 // `smoothed` and smoothed_noise its noise sigma. Returns the threshold used.
 double SegmentScale(const cv::Mat& smoothed, double smoothed_noise, int scale,
                     const LightDetectorOptions& options, int background_window_cells,
-                    double max_area_fraction, int full_cols, int full_rows,
+                    double min_area, double max_area_fraction, int full_cols, int full_rows,
                     std::vector<Blob>* blobs) {
   const int rows = smoothed.rows;
   const int cols = smoothed.cols;
@@ -619,7 +608,7 @@ double SegmentScale(const cv::Mat& smoothed, double smoothed_noise, int scale,
   const size_t first = blobs->size();
   for (int label = 1; label < num_labels; ++label) {
     const std::vector<int>& component = components[label];
-    if (component.size() * scale * scale < static_cast<size_t>(options.min_area_px) ||
+    if (static_cast<double>(component.size()) * scale * scale < min_area ||
         component.size() > max_area) {
       continue;
     }
@@ -802,52 +791,31 @@ struct Light {
   bool rejected = false;
 };
 
-// Per-channel mean over the disc of radius max(1, sigma / 2) around (u, v), and whether the disc
-// reaches full scale.
-void CentralDisc(const cv::Mat& image, double u, double v, double sigma,
-                 std::array<double, 3>* mean, std::array<bool, 3>* clipped) {
-  const double radius = std::max(1.0, 0.5 * sigma);
-  const int channels = image.channels();
-  std::array<double, 3> sum{};
-  int count = 0;
-  *clipped = {false, false, false};
-  for (int y = std::max(0, static_cast<int>(std::floor(v - radius)));
-       y <= std::min(image.rows - 1, static_cast<int>(std::ceil(v + radius))); ++y) {
-    const uint8_t* row = image.ptr<uint8_t>(y);
-    for (int x = std::max(0, static_cast<int>(std::floor(u - radius)));
-         x <= std::min(image.cols - 1, static_cast<int>(std::ceil(u + radius))); ++x) {
-      if (std::hypot(x - u, y - v) > radius) continue;
-      ++count;
-      for (int c = 0; c < channels; ++c) {
-        sum[c] += row[channels * x + c];
-        if (row[channels * x + c] >= kFullScale) (*clipped)[c] = true;
-      }
-    }
-  }
-  for (int c = 0; c < channels; ++c) (*mean)[c] = count > 0 ? sum[c] / count : 0.0;
-}
-
 }  // namespace
 
 LightDetector::LightDetector(const LightDetectorOptions& options)
-    : options_(options), dehazer_(options.dehaze_options) {}
+    : options_(options), dehazer_(options.dehaze_options) {
+  const LightDetectorOptions& o = options_;
+  if (!(o.prefilter_sigma_px >= 0.0) || o.median_ksize < 0 || o.background_grid_cols < 2 ||
+      o.background_window_cells < 1 || o.coarse_scale < 0 ||
+      o.coarse_background_window_cells < 1 || o.min_area_px < 1 || !(o.max_area_fraction > 0.0) ||
+      o.max_fit_pixels < 16 || !(o.min_contrast >= 0.0) || !(o.min_prominence >= 0.0) ||
+      !(o.max_fit_shift_sigmas > 0.0) || !(o.reflection_max_ratio > 0.0)) {
+    throw std::invalid_argument("LightDetectorOptions: a size or threshold is out of range");
+  }
+}
 
 std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
   if (bgr8.empty()) throw std::invalid_argument("LightDetector: empty image");
   if (bgr8.depth() != CV_8U || (bgr8.channels() != 1 && bgr8.channels() != 3)) {
     throw std::invalid_argument("LightDetector: image must be 8-bit BGR or gray");
   }
-  static const bool debug = std::getenv("AUVDOCK_DETECTOR_DEBUG") != nullptr;
   cv::Mat image = options_.dehaze ? dehazer_.Dehaze(bgr8).image : bgr8;
   if (!image.isContinuous()) image = image.clone();
   const int rows = image.rows;
   const int cols = image.cols;
   const int channels = image.channels();
 
-  using Clock = std::chrono::steady_clock;
-  static double acc[8] = {0}; static int ncalls = 0; static double t_fit = 0;
-  auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
-  const auto T0 = Clock::now();
   cv::Mat luma;
   if (channels == 3) {
     cv::cvtColor(image, luma, cv::COLOR_BGR2GRAY);
@@ -887,30 +855,21 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
     return true;
   };
 
-  const auto T1 = Clock::now();
   std::vector<Blob> blobs;
   const double threshold =
       SegmentScale(smoothed, smoothed_noise, 1, options_, options_.background_window_cells,
-                   options_.max_area_fraction, cols, rows, &blobs);
+                   options_.min_area_px, options_.max_area_fraction, cols, rows, &blobs);
   // Fits a candidate at full resolution and keeps it if the fit describes a light.
   std::vector<Light> lights;
   auto fit_and_check = [&](const Blob& blob) {
     const int c = blob.channel;
     const double noise_c = noise_of(c);
-    const auto F0 = Clock::now();
     const FitResult fit = FitLight(image, c, {blob.u, blob.v, blob.sigma, blob.amplitude}, noise_c,
                                    options_.max_fit_pixels, options_.fit_taper_sigmas,
                                    options_.model_reflections);
-    t_fit += ms(F0, Clock::now());
-    if (debug) {
-      std::printf("    fit scale %d ch %d: %.2f,%.2f s %.2f A %.1f -> ok %d %.2f,%.2f s %.2f A %.1f rms %.2f refl %.2f,%.2f s %.2f A %.1f\n",
-                  blob.scale, c, blob.u, blob.v, blob.sigma, blob.amplitude, fit.ok, fit.u, fit.v,
-                  fit.sigma, fit.amplitude, fit.rms, fit.reflection_u, fit.reflection_v, fit.reflection_sigma, fit.reflection_amplitude);
-    }
     // The coarse scale is there for big lights only.
-    if (!fit.ok || (blob.scale > 1 && fit.sigma < 0.5 * options_.coarse_min_sigma_px * cols / 640.0)) {
-      return false;
-    }
+    const double min_coarse_sigma = 0.5 * options_.coarse_min_sigma_px * cols / 640.0;
+    if (!fit.ok || (blob.scale > 1 && fit.sigma < min_coarse_sigma)) return false;
     Light light;
     light.blob = &blob;
     light.u = fit.u;
@@ -921,29 +880,30 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
     for (int k = 0; k < channels; ++k) {
       light.max_contrast = std::max(light.max_contrast, blob.channel_contrast[k]);
     }
+    // The fit must stay on the blob it started from (a fit that slides onto a neighbour or a
+    // deck edge moves by more than a fraction of its own sigma).
     const double shift = std::hypot(fit.u - blob.u, fit.v - blob.v) / std::max(0.5, fit.sigma);
     // The model must explain the blob's centre: a fit that drifted onto a faint bump beside a
     // bright plateau leaves most of the centre unexplained.
-    const double central = CentralMean(image, c, fit.u, fit.v, fit.sigma) - fit.background;
+    CentralDisc(image, fit.u, fit.v, fit.sigma, &light.core, &light.core_clipped);
+    const double central = light.core[c] - fit.background;
     const double explained = std::min(0.94 * fit.amplitude, kFullScale - fit.background);
     // Size against brightness: a light that looks big is near, and a near light is bright, so a
     // blob must rise by a minimum per pixel of sigma (per 640 pixels of image width, since sigma
     // scales with the focal length). The brightness is the fit's amplitude (which sees through
     // clipping and ignores a particle on the blob), scaled to the blob's brightest channel; a
     // clipped blob has a lower bar, since clipping leaves its amplitude uncertain.
-    const bool clipped = CoreClipped(image, fit.u, fit.v, fit.sigma);
+    const bool clipped =
+        light.core_clipped[0] || light.core_clipped[1] || light.core_clipped[2];
     const double size = fit.sigma * 640.0 / cols;
     const double min_contrast = (clipped ? options_.min_clipped_contrast_per_sigma
                                          : options_.min_contrast_per_sigma) * size;
     const double brightness =
         fit.amplitude * std::max(1.0, light.max_contrast / std::max(1.0, blob.channel_contrast[c]));
-    static const bool featq = std::getenv("AUVDOCK_FEATQ") != nullptr;
-    if (featq) std::printf("FEATQ %.3f %.3f q %.2f clipped %d sigma %.2f A %.1f maxc %.1f cc %.1f scale %d rmsn %.2f border %d area %.0f shift %.2f\n", fit.u, fit.v, brightness / size, (int)clipped, fit.sigma, fit.amplitude, light.max_contrast, blob.channel_contrast[c], blob.scale, fit.rms / noise_c, (int)blob.at_border, blob.area, shift);
     const bool too_big_unclipped =
         !clipped && options_.max_unclipped_sigma_px > 0.0 && size > options_.max_unclipped_sigma_px;
     if (central > 2.0 * explained + 3.0 * noise_c || shift > options_.max_fit_shift_sigmas ||
         fit.sigma < options_.min_sigma_px || brightness < min_contrast || too_big_unclipped) {
-      if (debug) std::printf("    inconsistent %.1f,%.1f central %.1f explained %.1f shift %.2f maxc %.1f min %.1f\n", fit.u, fit.v, central, explained, shift, light.max_contrast, min_contrast);
       return false;
     }
     // Particles: small and white (marine snow under the lamp), unlike the blue-green lights,
@@ -951,25 +911,66 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
     if (options_.reject_particles && channels == 3 &&
         fit.sigma <= options_.particle_max_sigma_px &&
         CoreRedRatio(image, fit.u, fit.v, fit.sigma) >= options_.particle_min_red_ratio) {
-      if (debug) std::printf("    particle %.1f,%.1f\n", fit.u, fit.v);
       return false;
     }
-    CentralDisc(image, fit.u, fit.v, fit.sigma, &light.core, &light.core_clipped);
     for (int k = 0; k < channels; ++k) light.core[k] -= blob.background[k];
     lights.push_back(light);
     return true;
   };
 
-  const auto T2 = Clock::now();
-  cv::Mat owner(rows, cols, CV_8U, cv::Scalar(0));  // 1 where a fine-scale light was found
-  for (Blob& blob : blobs) {
-    if (blob.luma_contrast < options_.min_peak_contrast || blob.area < options_.min_area_px ||
-        !MeasureBlob(image, options_, &blob) || !passes(blob) || !fit_and_check(blob)) {
-      continue;
+  // Reflections: a dimmer blob just below a brighter one, as far below as a reflection's geometry
+  // allows (a few source sigmas). Dimmer means a fainter core in the source's measuring channel;
+  // where that channel clips at the source's core, unclipped in some channel in which the source
+  // clips (a nearer light below a clipped one clips too).
+  auto is_reflection = [&](const Light& source, const Light& candidate) {
+    const double s = std::max(0.8, source.sigma);
+    const double dv = candidate.v - source.v;
+    const double du = std::abs(candidate.u - source.u);
+    if (dv < options_.reflection_min_offset_sigmas * s ||
+        dv > options_.reflection_max_offset_sigmas * s + options_.reflection_max_offset_px ||
+        du > options_.reflection_max_lateral_sigmas * s + 3.0) {
+      return false;
     }
-    for (int index : blob.pixels) owner.data[index] = 1;
+    const int c = source.blob->channel;
+    if (!source.core_clipped[c]) {
+      return candidate.core[c] < options_.reflection_max_ratio * source.core[c];
+    }
+    for (int k = 0; k < channels; ++k) {
+      if (source.core_clipped[k] && !candidate.core_clipped[k]) return true;
+    }
+    return false;
+  };
+
+  // Brightest first, so that a light is fitted before its reflection, which is then recognised
+  // (and not fitted) from its first centroid.
+  std::vector<Blob*> fine_order;
+  for (Blob& blob : blobs) {
+    if (blob.luma_contrast >= options_.min_peak_contrast && blob.area >= options_.min_area_px) {
+      fine_order.push_back(&blob);
+    }
   }
-  const auto T3 = Clock::now();
+  std::sort(fine_order.begin(), fine_order.end(),
+            [](const Blob* a, const Blob* b) { return a->luma_contrast > b->luma_contrast; });
+  cv::Mat owner(rows, cols, CV_8U, cv::Scalar(0));  // 1 where a fine-scale light was found
+  for (Blob* blob : fine_order) {
+    if (!MeasureBlob(image, options_, blob) || !passes(*blob)) continue;
+    if (options_.reject_reflections) {
+      Light provisional;
+      provisional.blob = blob;
+      provisional.u = blob->u;
+      provisional.v = blob->v;
+      provisional.sigma = blob->sigma;
+      CentralDisc(image, blob->u, blob->v, blob->sigma, &provisional.core,
+                  &provisional.core_clipped);
+      for (int k = 0; k < channels; ++k) provisional.core[k] -= blob->background[k];
+      const bool reflection =
+          std::any_of(lights.begin(), lights.end(),
+                      [&](const Light& light) { return is_reflection(light, provisional); });
+      if (reflection) continue;
+    }
+    if (!fit_and_check(*blob)) continue;
+    for (int index : blob->pixels) owner.data[index] = 1;
+  }
   // Lights bigger than the background window (the last metre of the landing) are found on a
   // downsampled image with a wide window; only the big ones are kept from that scale, and only
   // where the fine scale found no light.
@@ -978,18 +979,15 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
   if (f >= 2 && cols / f >= 16 && rows / f >= 16) {
     cv::Mat small;
     cv::resize(smoothed, small, cv::Size(cols / f, rows / f), 0, 0, cv::INTER_AREA);
-    SegmentScale(small, smoothed_noise / f, f, options_, options_.coarse_background_window_cells,
-                 1.0, cols, rows, &coarse_blobs);
     const double min_sigma = options_.coarse_min_sigma_px * cols / 640.0;
+    SegmentScale(small, smoothed_noise / f, f, options_, options_.coarse_background_window_cells,
+                 2.0 * kPi * min_sigma * min_sigma, 1.0, cols, rows, &coarse_blobs);
     for (Blob& blob : coarse_blobs) {
-      if (debug) std::printf("    coarse blob area %.0f lc %.1f\n", blob.area, blob.luma_contrast);
       if (blob.area < 2.0 * kPi * min_sigma * min_sigma ||
           blob.luma_contrast < options_.min_peak_contrast) {
         continue;
       }
-      const bool measured = MeasureBlob(image, options_, &blob);
-      if (debug) std::printf("    coarse measured %d %.1f,%.1f sigma %.1f el %.2f passes %d\n", measured, blob.u, blob.v, blob.sigma, blob.elongation, passes(blob));
-      if (!measured || blob.sigma < min_sigma || !passes(blob)) {
+      if (!MeasureBlob(image, options_, &blob) || blob.sigma < min_sigma || !passes(blob)) {
         continue;
       }
       const int x = std::clamp(static_cast<int>(std::lround(blob.u)), 0, cols - 1);
@@ -999,10 +997,6 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
     }
   }
 
-
-  const auto T4 = Clock::now();
-  acc[0] += ms(T0, T1); acc[1] += ms(T1, T2); acc[2] += ms(T2, T3); acc[3] += ms(T3, T4); ++ncalls;
-  if (std::getenv("AUVDOCK_TIMING") && ncalls % 600 == 0) std::printf("pre %.3f segfine %.3f measure+fit fine %.3f (fit %.3f) coarse %.3f\n", acc[0] / ncalls, acc[1] / ncalls, acc[2] / ncalls, t_fit / ncalls, acc[3] / ncalls);
   // The same light found twice (by both scales, or as two blobs): keep the first, which comes
   // from the finer scale.
   for (size_t i = 0; i < lights.size(); ++i) {
@@ -1014,43 +1008,21 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
     }
   }
 
-  // Reflections: a dimmer blob just below a brighter one, as far below as a reflection's geometry
-  // allows (a few source sigmas), compared in the source's measuring channel (unclipped there
-  // when possible).
+  // Reflections found after the fit (two blobs whose fits converged close together, or a
+  // reflection fitted before its source).
   if (options_.reject_reflections) {
     std::vector<size_t> order(lights.size());
     std::iota(order.begin(), order.end(), 0);
-    std::sort(order.begin(), order.end(),
-              [&](size_t a, size_t b) {
-                return lights[a].blob->luma_energy > lights[b].blob->luma_energy;
-              });
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      return lights[a].blob->luma_contrast > lights[b].blob->luma_contrast;
+    });
     for (size_t j : order) {
-      const Light& source = lights[j];
-      if (source.rejected) continue;
-      const double s = std::max(0.8, source.sigma);
-      const int c = source.blob->channel;
+      if (lights[j].rejected) continue;
       for (Light& candidate : lights) {
-        if (candidate.rejected || &candidate == &source) continue;
-        const double dv = candidate.v - source.v;
-        const double du = std::abs(candidate.u - source.u);
-        if (dv < options_.reflection_min_offset_sigmas * s ||
-            dv > options_.reflection_max_offset_sigmas * s + options_.reflection_max_offset_px ||
-            du > options_.reflection_max_lateral_sigmas * s + 3.0) {
-          continue;
+        if (!candidate.rejected && &candidate != &lights[j] &&
+            is_reflection(lights[j], candidate)) {
+          candidate.rejected = true;
         }
-        // Dimmer: a fainter core in the source's measuring channel; where that channel clips at
-        // the source's core, unclipped in some channel in which the source clips (a nearer
-        // light below a clipped one clips too).
-        bool dimmer = false;
-        if (!source.core_clipped[c]) {
-          dimmer = candidate.core[c] < options_.reflection_max_ratio * source.core[c];
-        } else {
-          for (int k = 0; k < channels; ++k) {
-            if (source.core_clipped[k] && !candidate.core_clipped[k]) dimmer = true;
-          }
-        }
-        if (debug) std::printf("    pair src %.1f,%.1f s %.2f cand %.1f,%.1f dv/s %.2f du/s %.2f ch %d clip %d core %.1f/%.1f -> %d\n", source.u, source.v, s, candidate.u, candidate.v, dv / s, du / s, c, (int)source.core_clipped[c], candidate.core[c], source.core[c], (int)dimmer);
-        if (dimmer) candidate.rejected = true;
       }
     }
   }
@@ -1068,8 +1040,6 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
     const double fit_term = std::exp(-light.rms / std::max(1.0, 0.1 * light.amplitude));
     const double size_term = std::min(1.0, light.sigma / 1.5);
     d.score = std::clamp(contrast_term * fit_term * size_term, 0.0, 1.0);
-    static const bool feat = std::getenv("AUVDOCK_FEAT") != nullptr;
-    if (feat && false) std::printf("FEAT %.3f %.3f sigma %.2f A %.1f maxc %.1f el %.2f border %d rms %.2f red %.2f ch %d\n", light.u, light.v, light.sigma, light.amplitude, light.max_contrast, light.blob->elongation, light.blob->at_border, light.rms, light.blob->red_ratio, light.blob->channel);
     detections.push_back(d);
   }
   std::sort(detections.begin(), detections.end(),
