@@ -90,6 +90,16 @@ double CsvReader::Double(int column) const {
   return value;
 }
 
+bool CsvReader::HasNonFiniteNumber(int first, int last) const {
+  for (int column = first; column <= last && column < static_cast<int>(fields_.size()); ++column) {
+    const std::string& f = fields_[column];
+    double value = 0.0;
+    const auto [end, ec] = std::from_chars(f.data(), f.data() + f.size(), value);
+    if (ec == std::errc() && end == f.data() + f.size() && !std::isfinite(value)) return true;
+  }
+  return false;
+}
+
 std::string FormatDouble(double value) {
   char buffer[64];
   const auto [end, ec] = std::to_chars(buffer, buffer + sizeof(buffer), value);

@@ -19,7 +19,7 @@ std::string SensorCsv(const fs::path& root, const std::string& name) {
   return fs::exists(p) ? p.string() : std::string();
 }
 
-Dataset LoadAuvdockDataset(const fs::path& root) {
+Dataset LoadAuvdockDataset(const fs::path& root, std::vector<std::string>* skipped) {
   Dataset ds;
   ds.root = root.string();
   ds.layout = DatasetLayout::kAuvdock;
@@ -29,23 +29,23 @@ Dataset LoadAuvdockDataset(const fs::path& root) {
   for (const auto& cam : ds.calibration.cameras) {
     const std::string csv = SensorCsv(root, cam.name);
     if (csv.empty()) throw InputError((root / cam.name / "data.csv").string() + ": missing");
-    ds.camera_frames[cam.name] = ReadCameraCsv(csv, (root / cam.name / "data").string());
+    ds.camera_frames[cam.name] = ReadCameraCsv(csv, (root / cam.name / "data").string(), skipped);
   }
   if (ds.calibration.imu) {
     const std::string csv = SensorCsv(root, ds.calibration.imu->name);
-    if (!csv.empty()) ds.imu = ReadImuCsv(csv);
+    if (!csv.empty()) ds.imu = ReadImuCsv(csv, skipped);
   }
   if (ds.calibration.depth) {
     const std::string csv = SensorCsv(root, ds.calibration.depth->name);
-    if (!csv.empty()) ds.depth = ReadDepthCsv(csv);
+    if (!csv.empty()) ds.depth = ReadDepthCsv(csv, skipped);
   }
   if (ds.calibration.dvl) {
     const std::string csv = SensorCsv(root, ds.calibration.dvl->name);
-    if (!csv.empty()) ds.dvl = ReadDvlCsv(csv);
+    if (!csv.empty()) ds.dvl = ReadDvlCsv(csv, skipped);
   }
   if (ds.calibration.acoustic) {
     const std::string csv = SensorCsv(root, ds.calibration.acoustic->name);
-    if (!csv.empty()) ds.acoustic = ReadAcousticCsv(csv);
+    if (!csv.empty()) ds.acoustic = ReadAcousticCsv(csv, skipped);
   }
   const fs::path gt = root / "groundtruth";
   if (fs::exists(gt / "data.csv")) ds.groundtruth = ReadGroundTruthCsv((gt / "data.csv").string());
@@ -58,14 +58,16 @@ Dataset LoadAuvdockDataset(const fs::path& root) {
 
 }  // namespace
 
-Dataset LoadDataset(const std::string& dir) {
+Dataset LoadDataset(const std::string& dir) { return LoadDataset(dir, nullptr); }
+
+Dataset LoadDataset(const std::string& dir, std::vector<std::string>* skipped_rows) {
   const fs::path root(dir);
   std::error_code ec;
   if (!fs::is_directory(root, ec)) throw InputError(dir + ": not a dataset folder");
-  if (fs::exists(root / "calibration.yaml")) return LoadAuvdockDataset(root);
-  if (fs::is_directory(root / "mav0")) return internal::LoadEurocDataset((root / "mav0").string());
+  if (fs::exists(root / "calibration.yaml")) return LoadAuvdockDataset(root, skipped_rows);
+  if (fs::is_directory(root / "mav0")) return internal::LoadEurocDataset((root / "mav0").string(), skipped_rows);
   if (fs::exists(root / "imu0" / "sensor.yaml") || fs::exists(root / "cam0" / "sensor.yaml")) {
-    return internal::LoadEurocDataset(root.string());
+    return internal::LoadEurocDataset(root.string(), skipped_rows);
   }
   throw InputError(dir + ": not a dataset folder (no calibration.yaml, and no EuRoC mav0/)");
 }

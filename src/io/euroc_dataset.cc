@@ -77,7 +77,7 @@ ImuCalibration ReadEurocImu(const std::string& yaml_path) {
 
 }  // namespace
 
-Dataset LoadEurocDataset(const std::string& mav_dir) {
+Dataset LoadEurocDataset(const std::string& mav_dir, std::vector<std::string>* skipped_rows) {
   Dataset ds;
   ds.root = mav_dir;
   ds.layout = DatasetLayout::kEuroc;
@@ -96,7 +96,7 @@ Dataset LoadEurocDataset(const std::string& mav_dir) {
     ds.calibration.cameras.push_back(ReadEurocCamera(name, (dir / "sensor.yaml").string()));
     if (fs::exists(dir / "data.csv")) {
       ds.camera_frames[name] =
-          ReadCameraCsv((dir / "data.csv").string(), (dir / "data").string());
+          ReadCameraCsv((dir / "data.csv").string(), (dir / "data").string(), skipped_rows);
     }
   }
 
@@ -104,7 +104,7 @@ Dataset LoadEurocDataset(const std::string& mav_dir) {
   if (fs::exists(imu_dir / "sensor.yaml")) {
     ds.calibration.imu = ReadEurocImu((imu_dir / "sensor.yaml").string());
   }
-  if (fs::exists(imu_dir / "data.csv")) ds.imu = ReadImuCsv((imu_dir / "data.csv").string());
+  if (fs::exists(imu_dir / "data.csv")) ds.imu = ReadImuCsv((imu_dir / "data.csv").string(), skipped_rows);
 
   const fs::path gt = fs::path(mav_dir) / "state_groundtruth_estimate0" / "data.csv";
   if (fs::exists(gt)) ds.groundtruth = ReadGroundTruthCsv(gt.string());

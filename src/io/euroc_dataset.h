@@ -8,12 +8,13 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "auvdock/io/dataset.h"
 
 namespace auvdock::internal {
 
 // mav_dir is the ".../mav0" folder.
-Dataset LoadEurocDataset(const std::string& mav_dir);
+Dataset LoadEurocDataset(const std::string& mav_dir, std::vector<std::string>* skipped_rows);
 
 }  // namespace auvdock::internal

@@ -43,18 +43,36 @@ int64_t ReadTime(const CsvReader& reader, int64_t* previous) {
   return t;
 }
 
+// In lenient mode (skipped != null): true when the row must be left out (a non-finite number
+// in columns [1, last_numeric] or a timestamp that does not increase), with the reason logged.
+bool SkipRow(const CsvReader& reader, int last_numeric, const int64_t* previous,
+             std::vector<std::string>* skipped) {
+  if (skipped == nullptr) return false;
+  std::string why;
+  if (reader.HasNonFiniteNumber(1, last_numeric)) {
+    why = "NaN/Inf";
+  } else if (*previous != kNoTime && reader.Int64(0) <= *previous) {
+    why = "timestamp not increasing";
+  }
+  if (why.empty()) return false;
+  skipped->push_back(reader.path() + ": line " + std::to_string(reader.line()) + ": " + why +
+                     ": row skipped");
+  return true;
+}
+
 Eigen::Vector3d Read3(const CsvReader& reader, int first) {
   return Eigen::Vector3d(reader.Double(first), reader.Double(first + 1), reader.Double(first + 2));
 }
 
 }  // namespace
 
-std::vector<ImuSample> ReadImuCsv(const std::string& path) {
+std::vector<ImuSample> ReadImuCsv(const std::string& path, std::vector<std::string>* skipped) {
   CsvReader reader(path, {"timestamp", "w_RS_S_x", "w_RS_S_y", "w_RS_S_z", "a_RS_S_x",
                           "a_RS_S_y", "a_RS_S_z"});
   std::vector<ImuSample> samples;
   int64_t previous = kNoTime;
   while (reader.Next()) {
+    if (SkipRow(reader, 6, &previous, skipped)) continue;
     ImuSample s;
     s.t_ns = ReadTime(reader, &previous);
     s.gyro = Read3(reader, 1);
@@ -64,11 +82,13 @@ std::vector<ImuSample> ReadImuCsv(const std::string& path) {
   return samples;
 }
 
-std::vector<CameraFrame> ReadCameraCsv(const std::string& path, const std::string& image_dir) {
+std::vector<CameraFrame> ReadCameraCsv(const std::string& path, const std::string& image_dir,
+                                       std::vector<std::string>* skipped) {
   CsvReader reader(path, {"timestamp", "filename"});
   std::vector<CameraFrame> frames;
   int64_t previous = kNoTime;
   while (reader.Next()) {
+    if (SkipRow(reader, 0, &previous, skipped)) continue;
     CameraFrame f;
     f.t_ns = ReadTime(reader, &previous);
     const std::string& name = reader.String(1);
@@ -81,11 +101,13 @@ std::vector<CameraFrame> ReadCameraCsv(const std::string& path, const std::strin
   return frames;
 }
 
-std::vector<DepthMeasurement> ReadDepthCsv(const std::string& path) {
+std::vector<DepthMeasurement> ReadDepthCsv(const std::string& path,
+                                           std::vector<std::string>* skipped) {
   CsvReader reader(path, {"timestamp", "depth"});
   std::vector<DepthMeasurement> out;
   int64_t previous = kNoTime;
   while (reader.Next()) {
+    if (SkipRow(reader, 1, &previous, skipped)) continue;
     DepthMeasurement m;
     m.t_ns = ReadTime(reader, &previous);
     m.depth_m = reader.Double(1);
@@ -94,11 +116,13 @@ std::vector<DepthMeasurement> ReadDepthCsv(const std::string& path) {
   return out;
 }
 
-std::vector<DvlMeasurement> ReadDvlCsv(const std::string& path) {
+std::vector<DvlMeasurement> ReadDvlCsv(const std::string& path,
+                                       std::vector<std::string>* skipped) {
   CsvReader reader(path, {"timestamp", "v_S_x", "v_S_y", "v_S_z"});
   std::vector<DvlMeasurement> out;
   int64_t previous = kNoTime;
   while (reader.Next()) {
+    if (SkipRow(reader, 3, &previous, skipped)) continue;
     DvlMeasurement m;
     m.t_ns = ReadTime(reader, &previous);
     m.v_S = Read3(reader, 1);
@@ -107,11 +131,13 @@ std::vector<DvlMeasurement> ReadDvlCsv(const std::string& path) {
   return out;
 }
 
-std::vector<AcousticFix> ReadAcousticCsv(const std::string& path) {
+std::vector<AcousticFix> ReadAcousticCsv(const std::string& path,
+                                         std::vector<std::string>* skipped) {
   CsvReader reader(path, {"timestamp", "p_D_x", "p_D_y", "p_D_z", "sigma"});
   std::vector<AcousticFix> out;
   int64_t previous = kNoTime;
   while (reader.Next()) {
+    if (SkipRow(reader, 4, &previous, skipped)) continue;
     AcousticFix m;
     m.t_ns = ReadTime(reader, &previous);
     m.p_D = Read3(reader, 1);

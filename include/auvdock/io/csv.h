@@ -29,6 +29,9 @@ class CsvReader {
 
   int64_t Int64(int column) const;
   double Double(int column) const;  // finite only
+  // True when one of the columns [first, last] holds a number that parses as NaN or +-Inf
+  // (malformed text is not reported here; Double() rejects it).
+  bool HasNonFiniteNumber(int first, int last) const;
   const std::string& String(int column) const { return fields_.at(column); }
   int line() const { return line_; }
   const std::string& path() const { return path_; }

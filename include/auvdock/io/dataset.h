@@ -35,5 +35,9 @@ struct Dataset {
 // Loads a dataset folder. `dir` may be an auvdock dataset, a EuRoC sequence folder (containing
 // mav0/) or its mav0/ folder itself. Throws InputError on anything missing or malformed.
 Dataset LoadDataset(const std::string& dir);
+// The same, but sensor rows (IMU, cameras, depth, DVL, acoustic) with NaN/Inf or a timestamp
+// that does not increase are left out and described in `skipped_rows` instead of failing the
+// load (for `auvdock run`, which goes on past a bad measurement). Malformed files still throw.
+Dataset LoadDataset(const std::string& dir, std::vector<std::string>* skipped_rows);
 
 }  // namespace auvdock

@@ -23,12 +23,21 @@ extern const char kGroundTruthCsvHeader[];
 extern const char kVisibilityCsvHeader[];
 extern const char kFaultsCsvHeader[];
 
-std::vector<ImuSample> ReadImuCsv(const std::string& path);
+// Sensor readers. Strict by default: a row with NaN/Inf or a timestamp that does not increase
+// is an InputError naming the file and line. With `skipped` given, such a row is left out and
+// described there instead ("imu0/data.csv: line 17: NaN/Inf: row skipped"), so that a run can
+// go on past a bad measurement; malformed text is an error either way.
+std::vector<ImuSample> ReadImuCsv(const std::string& path,
+                                  std::vector<std::string>* skipped = nullptr);
 // Camera frames; each path is made absolute as <image_dir>/<filename>.
-std::vector<CameraFrame> ReadCameraCsv(const std::string& path, const std::string& image_dir);
-std::vector<DepthMeasurement> ReadDepthCsv(const std::string& path);
-std::vector<DvlMeasurement> ReadDvlCsv(const std::string& path);
-std::vector<AcousticFix> ReadAcousticCsv(const std::string& path);
+std::vector<CameraFrame> ReadCameraCsv(const std::string& path, const std::string& image_dir,
+                                       std::vector<std::string>* skipped = nullptr);
+std::vector<DepthMeasurement> ReadDepthCsv(const std::string& path,
+                                           std::vector<std::string>* skipped = nullptr);
+std::vector<DvlMeasurement> ReadDvlCsv(const std::string& path,
+                                       std::vector<std::string>* skipped = nullptr);
+std::vector<AcousticFix> ReadAcousticCsv(const std::string& path,
+                                         std::vector<std::string>* skipped = nullptr);
 std::vector<GroundTruthState> ReadGroundTruthCsv(const std::string& path);
 std::vector<VisibilityRecord> ReadVisibilityCsv(const std::string& path);
 std::vector<FaultRecord> ReadFaultsCsv(const std::string& path);

@@ -1,0 +1,42 @@
+// What the estimator takes from the vision front-end for one camera frame: identified lights,
+// already associated with the dock model.
+//
+//   mono:   lights identified in the mono camera's raw (distorted) image, pixels;
+//   stereo: lights identified in both stereo images and triangulated, p_S in S = the
+//           stereo-left camera frame (OpenCV axes), with the 3 x 3 covariance from pixel noise.
+// T_D_B_initial is a per-frame pose (the paper's baseline) used only to initialise or re-seed
+// the estimator; it never enters the cost.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "auvdock/geometry/pose3.h"
+
+namespace auvdock {
+
+struct MonoLightObservation {
+  int light_id = -1;
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // raw image, pixels
+  double sigma_px = 0.5;                         // 1-sigma per pixel coordinate
+};
+
+struct StereoLightObservation {
+  int light_id = -1;
+  Eigen::Vector3d p_S = Eigen::Vector3d::Zero();         // m
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // of p_S, m^2
+};
+
+struct VisionFrame {
+  int64_t t_ns = 0;
+  std::vector<MonoLightObservation> mono;
+  std::vector<StereoLightObservation> stereo;
+  std::optional<Pose3> T_D_B_initial;
+
+  bool empty() const { return mono.empty() && stereo.empty(); }
+};
+
+}  // namespace auvdock

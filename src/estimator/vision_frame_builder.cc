@@ -1,0 +1,62 @@
+#include "auvdock/estimator/vision_frame_builder.h"
+
+#include <map>
+
+#include "auvdock/vision/stereo_triangulation.h"
+
+namespace auvdock {
+namespace {
+
+// Detection index per identified light id; ids seen twice are dropped.
+std::map<int, int> IdentifiedLights(const CameraObservation& obs) {
+  std::map<int, int> index_of;
+  std::map<int, int> count;
+  for (std::size_t i = 0; i < obs.detections.size() && i < obs.light_ids.size(); ++i) {
+    const int id = obs.light_ids[i];
+    if (id < 0) continue;
+    index_of[id] = static_cast<int>(i);
+    ++count[id];
+  }
+  for (const auto& [id, n] : count) {
+    if (n > 1) index_of.erase(id);
+  }
+  return index_of;
+}
+
+}  // namespace
+
+VisionFrame MakeVisionFrame(const BaselineFrame& frame, const CameraCalibration* left,
+                            const CameraCalibration* right, const CameraCalibration* mono) {
+  VisionFrame out;
+  out.t_ns = frame.t_ns;
+  out.T_D_B_initial = frame.T_D_B;
+  if (mono) {
+    for (const auto& [id, i] : IdentifiedLights(frame.mono)) {
+      MonoLightObservation obs;
+      obs.light_id = id;
+      obs.uv = frame.mono.detections[i].uv;
+      obs.sigma_px = mono->pixel_noise_px;
+      out.mono.push_back(obs);
+    }
+  }
+  if (left && right) {
+    const std::map<int, int> in_left = IdentifiedLights(frame.left);
+    const std::map<int, int> in_right = IdentifiedLights(frame.right);
+    for (const auto& [id, l] : in_left) {
+      const auto r = in_right.find(id);
+      if (r == in_right.end()) continue;
+      const TriangulatedPoint point =
+          TriangulateLinear(frame.left.detections[l].uv, frame.right.detections[r->second].uv,
+                            *left, *right, left->pixel_noise_px);
+      if (!point.ok) continue;
+      StereoLightObservation obs;
+      obs.light_id = id;
+      obs.p_S = point.p_S;
+      obs.covariance = point.covariance;
+      out.stereo.push_back(obs);
+    }
+  }
+  return out;
+}
+
+}  // namespace auvdock
