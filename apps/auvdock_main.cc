@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   auvdock::cli::AddEvaluateCommand(app);
   auvdock::cli::AddFrontendCommand(app);
   auvdock::cli::AddPnpCommand(app);
+  auvdock::cli::AddRunCommand(app);
+  auvdock::cli::AddSmoothCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -11,5 +11,7 @@ void AddSimulateCommand(CLI::App& root);
 void AddEvaluateCommand(CLI::App& root);
 void AddPnpCommand(CLI::App& root);
 void AddFrontendCommand(CLI::App& root);
+void AddRunCommand(CLI::App& root);
+void AddSmoothCommand(CLI::App& root);
 
 }  // namespace auvdock::cli

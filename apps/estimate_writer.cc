@@ -1,0 +1,63 @@
+#include "apps/estimate_writer.h"
+
+#include <filesystem>
+#include <fstream>
+
+#include "auvdock/io/input_error.h"
+#include "auvdock/io/staged_directory.h"
+
+namespace fs = std::filesystem;
+
+namespace auvdock::cli {
+namespace {
+
+std::string CovarianceHeader() {
+  std::string header = "#timestamp [ns]";
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) header += ",c" + std::to_string(r) + std::to_string(c);
+  }
+  return header +
+         " (6x6 row-major; tangent [dp_D x y z (m), dtheta_D x y z (rad)]; "
+         "T_D_B = (p + dp, Exp(dtheta) q))";
+}
+
+std::string PrepareDirectory(const std::string& out_dir) {
+  RequireAbsentOrEmptyDirectory(out_dir);
+  fs::create_directories(out_dir);
+  return out_dir;
+}
+
+}  // namespace
+
+EstimateWriter::EstimateWriter(const std::string& out_dir)
+    : out_dir_(PrepareDirectory(out_dir)),
+      trajectory_(std::make_unique<TumWriter>(out_dir + "/trajectory.tum")),
+      covariance_(out_dir + "/covariance.csv", CovarianceHeader()),
+      decisions_(out_dir + "/decisions.csv", "#timestamp [ns],decision,reason") {}
+
+void EstimateWriter::Write(const EstimatorOutput& output, const GoNoGoDecision& decision) {
+  trajectory_->Append({output.t_ns, output.T_D_B});
+  if (output.covariance_ok) {
+    const Eigen::Matrix<double, 6, 6, Eigen::RowMajor> row_major = output.covariance;
+    covariance_.Row(output.t_ns, std::vector<double>(row_major.data(), row_major.data() + 36));
+  }
+  WriteNoEstimate(output.t_ns, decision);
+}
+
+void EstimateWriter::WriteNoEstimate(int64_t t_ns, const GoNoGoDecision& decision) {
+  decisions_.Line(std::to_string(t_ns) + "," + (decision.go ? "GO" : "NO-GO") + "," +
+                  decision.reason);
+}
+
+void EstimateWriter::WriteSummary(const nlohmann::json& summary) const {
+  const std::string path = out_dir_ + "/summary.json";
+  const std::string tmp = path + ".partial";
+  {
+    std::ofstream out(tmp);
+    out << summary.dump(2) << "\n";
+    if (!out) throw InputError(path + ": cannot write");
+  }
+  fs::rename(tmp, path);
+}
+
+}  // namespace auvdock::cli

@@ -1,0 +1,45 @@
+#include "apps/run_summary.h"
+
+#include <algorithm>
+
+namespace auvdock::cli {
+
+nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorStats& stats,
+                              const std::vector<std::string>& skipped_rows,
+                              const RunCounters& counters) {
+  const double data_duration_s = 1e-9 * static_cast<double>(source.last_t_ns() -
+                                                             source.first_t_ns());
+  const double without_decode = source.frontend_s() + counters.backend_s;
+  nlohmann::json summary;
+  summary["interrupted"] = counters.interrupted;
+  summary["frames"] = counters.frames;
+  summary["frames_in_dataset"] = source.num_frames();
+  summary["estimates"] = stats.frames_with_output;
+  summary["go_decisions"] = counters.go;
+  summary["unreadable_images"] = source.unreadable_images();
+  summary["imu_samples"] = stats.imu_samples;
+  summary["skipped"] = {{"dataset_rows", skipped_rows.size()},
+                        {"imu_samples", stats.skipped_imu},
+                        {"frames", stats.skipped_frames},
+                        {"observations", stats.skipped_observations}};
+  summary["vision_residuals"] = {{"used", stats.used_observations},
+                                 {"gated", stats.gated_observations}};
+  summary["resets"] = stats.resets;
+  summary["solver_failures"] = stats.solver_failures;
+  summary["covariance_failures"] = stats.covariance_failures;
+  summary["data_duration_s"] = data_duration_s;
+  summary["timing_s"] = {{"decode", source.decode_s()},
+                         {"frontend", source.frontend_s()},
+                         {"backend", counters.backend_s},
+                         {"total", counters.total_s}};
+  summary["realtime_factor"] = {
+      {"total", data_duration_s / std::max(1e-9, counters.total_s)},
+      {"without_decode", data_duration_s / std::max(1e-9, without_decode)},
+      {"backend", data_duration_s / std::max(1e-9, counters.backend_s)}};
+  std::vector<std::string> log = skipped_rows;
+  log.insert(log.end(), stats.log.begin(), stats.log.end());
+  summary["log"] = log;
+  return summary;
+}
+
+}  // namespace auvdock::cli

@@ -1,0 +1,29 @@
+// summary.json of `auvdock run` / `auvdock smooth`: counts of frames, estimates, GO decisions,
+// skipped measurements (with the log of what was skipped and every reset), and the time spent:
+// data_duration_s and timing_s {decode, frontend, backend, total}, plus the speed as a multiple
+// of real time with and without decoding and for the back-end alone.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "apps/vision_frame_source.h"
+#include "auvdock/estimator/sliding_window_estimator.h"
+
+namespace auvdock::cli {
+
+struct RunCounters {
+  int frames = 0;
+  int go = 0;
+  double backend_s = 0.0;
+  double total_s = 0.0;
+  bool interrupted = false;
+};
+
+nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorStats& stats,
+                              const std::vector<std::string>& skipped_rows,
+                              const RunCounters& counters);
+
+}  // namespace auvdock::cli

@@ -1,0 +1,123 @@
+// auvdock smooth --dataset DIR --out OUTDIR [--config FILE] [--quiet]
+//
+// Offline reconstruction of a whole log (SmoothBatch): the per-frame vision pipeline and the
+// causal sliding-window run first (their states are the warm start), then every state in one
+// sparse problem, with a progress display of the solver's iterations. Writes the same files as
+// `auvdock run` (apps/estimate_writer.h) from the batch result; the covariance is each pose's
+// marginal in the full problem, so it uses data before and after the pose.
+#include <chrono>
+#include <cstdio>
+#include <memory>
+
+#include "apps/commands.h"
+#include "apps/estimate_writer.h"
+#include "apps/run_summary.h"
+#include "apps/signal_flag.h"
+#include "apps/vision_frame_source.h"
+#include "auvdock/estimator/batch_smoother.h"
+#include "auvdock/estimator/estimator_config.h"
+#include "auvdock/io/dataset.h"
+#include "auvdock/io/input_error.h"
+
+namespace auvdock::cli {
+namespace {
+
+struct SmoothOptions {
+  std::string dataset;
+  std::string out;
+  std::string config;
+  bool quiet = false;
+};
+
+using Clock = std::chrono::steady_clock;
+double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+void Smooth(const SmoothOptions& options) {
+  const auto start = Clock::now();
+  const RunConfig config = options.config.empty() ? RunConfig{} : LoadRunConfig(options.config);
+  std::vector<std::string> skipped_rows;
+  const Dataset dataset = LoadDataset(options.dataset, &skipped_rows);
+  if (!dataset.calibration.imu) throw InputError(options.dataset + ": calibration has no IMU");
+  VisionFrameSource source(dataset);
+  SlidingWindowEstimator estimator(dataset.calibration, *dataset.dock, config.estimator);
+  EstimateWriter writer(options.out);
+
+  const CancellationToken cancel = InstallSignalCancellation();
+  RunCounters counters;
+  std::vector<VisionFrame> frames;
+  size_t next_imu = 0;
+  while (std::optional<VisionFrame> frame = source.Next()) {
+    cancel.ThrowIfCancelled();
+    const auto t0 = Clock::now();
+    while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= frame->t_ns) {
+      estimator.AddImu(dataset.imu[next_imu++]);
+    }
+    estimator.AddVisionFrame(*frame);
+    counters.backend_s += Seconds(Clock::now() - t0);
+    ++counters.frames;
+    frames.push_back(std::move(*frame));
+    if (!options.quiet && counters.frames % 20 == 0) {
+      std::fprintf(stderr, "\rsmooth: sliding window %d/%zu frames", counters.frames,
+                   source.num_frames());
+    }
+  }
+  if (!options.quiet) std::fprintf(stderr, "\n");
+
+  BatchSmootherOptions batch;
+  if (!options.quiet) {
+    batch.progress = [](int iteration, double cost) {
+      std::fprintf(stderr, "\rsmooth: batch iteration %d, cost %.6g   ", iteration, cost);
+    };
+  }
+  const auto t0 = Clock::now();
+  const BatchResult result = SmoothBatch(dataset.calibration, *dataset.dock, frames, dataset.imu,
+                                         estimator.History(), config.estimator, batch);
+  counters.backend_s += Seconds(Clock::now() - t0);
+  if (!options.quiet) std::fprintf(stderr, "\n");
+
+  GoNoGo go_no_go(config.go_no_go);
+  size_t next_output = 0;
+  for (const VisionFrame& frame : frames) {
+    if (next_output < result.outputs.size() && result.outputs[next_output].t_ns == frame.t_ns) {
+      const EstimatorOutput& out = result.outputs[next_output++];
+      const GoNoGoDecision decision = go_no_go.Decide(out);
+      counters.go += decision.go;
+      writer.Write(out, decision);
+    } else {
+      writer.WriteNoEstimate(frame.t_ns, go_no_go.NoEstimate("no state at this frame"));
+    }
+  }
+  counters.total_s = Seconds(Clock::now() - start);
+  EstimatorStats stats = estimator.stats();
+  stats.frames_with_output = result.stats.frames_with_output;
+  stats.used_observations = result.stats.used_observations;
+  stats.gated_observations = result.stats.gated_observations;
+  stats.covariance_failures = result.stats.covariance_failures;
+  nlohmann::json summary = MakeRunSummary(source, stats, skipped_rows, counters);
+  summary["batch"] = {{"segments", result.segments},
+                      {"iterations", result.iterations},
+                      {"initial_cost", result.initial_cost},
+                      {"final_cost", result.final_cost},
+                      {"converged", result.converged}};
+  writer.WriteSummary(summary);
+  std::printf("smooth: %d frames -> %s: %d estimates in %d segment(s), %d GO; batch %d "
+              "iterations, cost %.6g -> %.6g\n",
+              counters.frames, options.out.c_str(), result.stats.frames_with_output,
+              result.segments, counters.go, result.iterations, result.initial_cost,
+              result.final_cost);
+}
+
+}  // namespace
+
+void AddSmoothCommand(CLI::App& root) {
+  auto options = std::make_shared<SmoothOptions>();
+  CLI::App* sub = root.add_subcommand(
+      "smooth", "Batch smoothing of a whole log: trajectory, covariance, go/no-go decisions");
+  sub->add_option("--dataset", options->dataset, "Dataset folder")->required();
+  sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
+  sub->add_option("--config", options->config, "Estimator and go/no-go options (YAML)");
+  sub->add_flag("--quiet", options->quiet, "No progress display");
+  sub->callback([options] { Smooth(*options); });
+}
+
+}  // namespace auvdock::cli

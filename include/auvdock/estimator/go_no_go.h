@@ -1,0 +1,58 @@
+// The docking go/no-go decision, per estimator output: GO only when the estimate is both precise
+// enough for the landing and healthy; otherwise NO-GO with the first reason that failed.
+//
+// Checks, in order (thresholds in GoNoGoOptions):
+//   1. an estimate exists and its covariance is available (a rank-deficient or failed
+//      covariance is NO-GO: the estimator cannot say how wrong it is);
+//   2. recent vision: the newest frame with a used vision residual is at most
+//      max_vision_age_s old (on the IMU alone the error grows without a bound the vehicle
+//      should trust, whatever the covariance says);
+//   3. gating health: over the last gating_window_frames frames, the share of vision residuals
+//      rejected by the chi-square gate is at most max_gating_rate (many rejections mean the
+//      model and the data disagree: misidentified lights, reflections, a bad calibration);
+//   4. lateral precision: 3 sigma of the horizontal position, along the major axis of its 2 x 2
+//      covariance in the dock frame (x, y), is at most allowed_lateral_error_m (the landing
+//      tolerance of the platform; the major axis covers the along-track and cross-track
+//      directions alike);
+//   5. heading precision: 3 sigma of the rotation about the dock's z axis at most
+//      max_yaw_3sigma_rad.
+// Units: metres, radians, seconds. The covariance is the estimator's, in the PoseManifold
+// tangent space [dp_D, dtheta_D].
+#pragma once
+
+#include <deque>
+#include <string>
+
+#include "auvdock/estimator/sliding_window_estimator.h"
+
+namespace auvdock {
+
+struct GoNoGoOptions {
+  double allowed_lateral_error_m = 0.10;
+  double max_yaw_3sigma_rad = 0.05;  // about 3 degrees
+  double max_vision_age_s = 0.5;
+  double max_gating_rate = 0.3;
+  int gating_window_frames = 20;
+};
+
+struct GoNoGoDecision {
+  bool go = false;
+  std::string reason;  // one line, no commas (it is a CSV field)
+};
+
+class GoNoGo {
+ public:
+  // Throws std::invalid_argument for non-positive thresholds.
+  explicit GoNoGo(const GoNoGoOptions& options = {});
+
+  // Decides for one output (and remembers its gating counts for the health check).
+  GoNoGoDecision Decide(const EstimatorOutput& output);
+  // A frame without an estimate (not initialised, reset): always NO-GO with the given reason.
+  GoNoGoDecision NoEstimate(const std::string& reason);
+
+ private:
+  GoNoGoOptions options_;
+  std::deque<std::pair<int, int>> recent_;  // (used, gated) per frame
+};
+
+}  // namespace auvdock

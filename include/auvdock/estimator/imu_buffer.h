@@ -1,0 +1,46 @@
+// A time-ordered buffer of IMU samples that preintegrates any interval [t0, t1] between states.
+//
+// Each sample is held (zero-order hold) from its own time to the next sample's, as the
+// simulator and most IMU drivers define a sample; the interval's first piece uses the last
+// sample at or before t0, the last piece the last sample at or before t1 (nothing after t1 is
+// used, which keeps the estimator causal). A hole longer than max_gap_s anywhere in [t0, t1]
+// (including before the first or after the last sample) means the interval is not covered.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+
+#include "auvdock/imu/imu_preintegration.h"
+#include "auvdock/io/calibration.h"
+#include "auvdock/io/measurements.h"
+
+namespace auvdock {
+
+class ImuBuffer {
+ public:
+  ImuBuffer(const ImuCalibration& calibration, double max_gap_s);
+
+  // Appends a sample; returns an empty string, or why it was skipped (not finite, not after the
+  // previous sample).
+  std::string Add(const ImuSample& sample);
+
+  // Preintegration over [t0_ns, t1_ns] at the linearisation bias; nothing when the interval is
+  // empty or not covered.
+  std::optional<ImuPreintegration> Preintegrate(int64_t t0_ns, int64_t t1_ns,
+                                                const ImuBias& bias) const;
+
+  // Forgets samples no longer needed for intervals starting at or after t_ns.
+  void DropBefore(int64_t t_ns);
+
+  bool empty() const { return samples_.empty(); }
+  int64_t newest_t_ns() const { return samples_.empty() ? INT64_MIN : samples_.back().t_ns; }
+
+ private:
+  ImuNoiseDensities noise_;
+  int64_t max_gap_ns_;
+  std::deque<ImuSample> samples_;
+};
+
+}  // namespace auvdock

@@ -1,0 +1,172 @@
+// Sliding-window factor-graph estimator (fixed-lag smoother) of the vehicle's pose in the dock
+// frame, on Ceres: the heart of auvdock.
+//
+// States live at camera frames: x_k = (T_D_B, v_D, b_g, b_a) (layout in factors/pose_manifold.h).
+// The cost over the window of the last N states is
+//   |r_prior|^2                                      marginalization prior (or the initial priors)
+// + sum_k |r_imu(x_k, x_k+1)|^2                      IMU preintegration between consecutive states
+// + sum_k sum_lights w_mono(k)   rho(|r_mono|^2)     mono reprojection of identified dock lights
+// + sum_k sum_lights w_stereo(k) rho(|r_stereo|^2)   triangulated lights against the dock model
+// where every r is whitened by its own noise model (pixel noise, triangulation covariance,
+// preintegrated IMU covariance), rho is a Huber loss, and w are the stage weights
+// (estimator/stage_weighting.h: by default pure information weighting, w = 1). This is the
+// source paper's stage-weighted mono/stereo fusion done inside one problem, not as an average
+// of two poses after the fact.
+//
+// Each new frame: preintegrate the IMU since the previous state, predict the new state, add the
+// factors, solve (Levenberg-Marquardt, iteration and time budget), gate vision residuals whose
+// Mahalanobis distance exceeds the chi-square gate and re-solve without them, then marginalize
+// the oldest state into the prior when the window is full (estimator/marginalization.h).
+// Without vision the window carries on on the IMU alone; the covariance grows accordingly.
+//
+// Initialisation: at the first frame with a per-frame pose (VisionFrame::T_D_B_initial): that
+// pose, zero velocity and zero biases, each with a prior (EstimatorOptions). The attitude then
+// refines against gravity through the IMU factors (gravity_D is the dock's, not a constant).
+// Reset: an IMU gap longer than max_imu_gap_s, or a failed solve, drops the window and waits
+// for the next per-frame pose; every reset is counted and logged.
+//
+// Causality: a frame's output uses only the IMU samples up to its timestamp (the last sample is
+// held to the frame time) and frames up to it.
+//
+// Frames and units: D dock (z down), B body = IMU, S stereo-left camera, C mono camera; metres,
+// radians, seconds; time stamps in ns. Covariances are in the PoseManifold tangent space
+// [dp_D (3), dtheta_D (3)].
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "auvdock/estimator/imu_buffer.h"
+#include "auvdock/estimator/stage_weighting.h"
+#include "auvdock/estimator/vision_factors.h"
+#include "auvdock/estimator/vision_frame.h"
+#include "auvdock/geometry/dock_model.h"
+#include "auvdock/geometry/pose3.h"
+#include "auvdock/imu/imu_preintegration.h"
+#include "auvdock/io/calibration.h"
+#include "auvdock/io/measurements.h"
+
+namespace ceres {
+class Problem;
+}
+
+namespace auvdock {
+
+class PoseManifold;
+
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+struct EstimatorOptions {
+  int window_size = 10;                  // states in the window (>= 2)
+  int max_solver_iterations = 10;        // per solve
+  double max_solver_time_s = 0.0;        // per solve; 0 = no time limit (deterministic)
+  VisionFactorOptions vision;           // mono/stereo on/off, Huber threshold, stage weights
+  // Chi-square gates on the squared Mahalanobis distance of each vision residual after the
+  // solve (p = 0.999: 13.82 for a pixel pair, 16.27 for a 3-D point); 0 = no gating.
+  double mono_gate_chi2 = 13.82;
+  double stereo_gate_chi2 = 16.27;
+  double max_imu_gap_s = 0.1;            // a longer gap between IMU samples resets the window
+  // Initial priors (1-sigma).
+  double init_position_sigma_m = 0.5;
+  double init_attitude_sigma_rad = 0.2;
+  double init_velocity_sigma_mps = 0.5;
+  double init_gyro_bias_sigma = 0.01;   // rad/s
+  double init_accel_bias_sigma = 0.1;   // m/s^2
+  bool compute_covariance = true;       // marginal covariance of the newest pose every frame
+};
+
+// The estimate at one state.
+struct EstimatorOutput {
+  int64_t t_ns = 0;
+  Pose3 T_D_B;
+  Eigen::Vector3d v_D = Eigen::Vector3d::Zero();
+  ImuBias bias;
+  bool covariance_ok = false;                   // false: rank-deficient or not computed
+  Matrix6d covariance = Matrix6d::Zero();       // tangent [dp_D, dtheta_D]
+  int n_mono = 0, n_stereo = 0;                 // vision residuals used in this frame
+  int n_gated = 0;                              // vision residuals rejected in this frame
+  double seconds_since_vision = -1.0;           // age of the newest used vision (-1: never)
+};
+
+// Why a frame produced no estimate, or what it skipped.
+struct EstimatorStats {
+  int frames = 0;
+  int frames_with_output = 0;
+  int imu_samples = 0;
+  int skipped_imu = 0;          // out of order, repeated, NaN/Inf
+  int skipped_frames = 0;       // out of order or repeated timestamps
+  int skipped_observations = 0; // NaN/Inf or unknown light ids
+  int gated_observations = 0;
+  int used_observations = 0;
+  int resets = 0;
+  int solver_failures = 0;
+  int covariance_failures = 0;
+  std::vector<std::string> log;  // one line per skip/reset, for the caller's log
+};
+
+// A state as it left the window (its smoothed, final fixed-lag estimate), for the batch smoother.
+struct StateRecord {
+  int64_t t_ns = 0;
+  double pose[7];
+  double velocity[3];
+  double bias[6];
+};
+
+class SlidingWindowEstimator {
+ public:
+  // Needs the calibration's IMU and the cameras with roles stereo_left (for stereo points) and
+  // mono (for mono reprojections). Throws std::invalid_argument for bad options.
+  SlidingWindowEstimator(const Calibration& calibration, const DockModel& dock,
+                         const EstimatorOptions& options = {});
+  ~SlidingWindowEstimator();
+  SlidingWindowEstimator(const SlidingWindowEstimator&) = delete;
+  SlidingWindowEstimator& operator=(const SlidingWindowEstimator&) = delete;
+
+  // IMU samples in time order; a sample out of order, repeated or not finite is skipped.
+  void AddImu(const ImuSample& sample);
+
+  // A camera frame (identified lights; possibly none). Returns the newest state's estimate, or
+  // nothing before initialisation / after a reset until the next per-frame pose.
+  std::optional<EstimatorOutput> AddVisionFrame(const VisionFrame& frame);
+
+  // The newest estimate propagated with the IMU samples received after it (for the controller,
+  // at IMU rate); nothing when not initialised or t_ns is before the newest state.
+  std::optional<Pose3> PropagatedPose(int64_t t_ns) const;
+
+  // States that have left the window, oldest first, plus the ones still in it (Flush order).
+  std::vector<StateRecord> History() const;
+
+  const EstimatorStats& stats() const { return stats_; }
+  bool initialized() const { return !window_.empty(); }
+
+ private:
+  struct State;
+
+  bool Initialize(const VisionFrame& frame);
+  void Reset(const std::string& reason);
+  bool AddState(int64_t t_ns);
+  bool Solve();
+  void MarginalizeOldest();
+  EstimatorOutput Output(const State& state);
+
+  Calibration calibration_;
+  DockModel dock_;
+  EstimatorOptions options_;
+  VisionRig rig_;
+  std::unique_ptr<PoseManifold> pose_manifold_;
+  std::unique_ptr<ceres::Problem> problem_;
+  std::deque<std::unique_ptr<State>> window_;
+  ImuBuffer imu_;
+  std::vector<StateRecord> history_;
+  int64_t last_frame_t_ns_ = INT64_MIN;
+  int64_t last_vision_t_ns_ = INT64_MIN;
+  EstimatorStats stats_;
+};
+
+}  // namespace auvdock

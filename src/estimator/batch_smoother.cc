@@ -1,0 +1,202 @@
+#include "auvdock/estimator/batch_smoother.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <stdexcept>
+
+#include <ceres/covariance.h>
+#include <ceres/iteration_callback.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include "auvdock/estimator/imu_buffer.h"
+#include "auvdock/estimator/vision_factors.h"
+#include "factors/bias_prior_factor.h"
+#include "factors/imu_preintegration_factor.h"
+#include "factors/pose_manifold.h"
+#include "factors/pose_prior_factor.h"
+#include "factors/velocity_prior_factor.h"
+
+namespace auvdock {
+namespace {
+
+struct BatchState {
+  int64_t t_ns = 0;
+  double pose[kPoseSize];
+  double velocity[kVelocitySize];
+  double bias[kBiasSize];
+  std::vector<VisionResidual> vision;
+  int n_gated = 0;
+};
+
+class ProgressCallback final : public ceres::IterationCallback {
+ public:
+  explicit ProgressCallback(const std::function<void(int, double)>& progress)
+      : progress_(progress) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (progress_) progress_(summary.iteration, summary.cost);
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  const std::function<void(int, double)>& progress_;
+};
+
+void AddInitialPriors(ceres::Problem* problem, const EstimatorOptions& o, BatchState* s) {
+  Matrix6d pose_cov = Matrix6d::Zero();
+  pose_cov.topLeftCorner<3, 3>().diagonal().setConstant(o.init_position_sigma_m *
+                                                        o.init_position_sigma_m);
+  pose_cov.bottomRightCorner<3, 3>().diagonal().setConstant(o.init_attitude_sigma_rad *
+                                                            o.init_attitude_sigma_rad);
+  const Pose3 prior_pose(Eigen::Map<const Eigen::Quaterniond>(s->pose + 3).normalized(),
+                         Eigen::Map<const Eigen::Vector3d>(s->pose));
+  problem->AddResidualBlock(PosePriorFactor::Create(prior_pose, pose_cov), nullptr, s->pose);
+  problem->AddResidualBlock(
+      VelocityPriorFactor::Create(Eigen::Vector3d::Zero(),
+                                  Eigen::Matrix3d::Identity() * o.init_velocity_sigma_mps *
+                                      o.init_velocity_sigma_mps),
+      nullptr, s->velocity);
+  Matrix6d bias_cov = Matrix6d::Zero();
+  bias_cov.topLeftCorner<3, 3>().diagonal().setConstant(o.init_gyro_bias_sigma *
+                                                        o.init_gyro_bias_sigma);
+  bias_cov.bottomRightCorner<3, 3>().diagonal().setConstant(o.init_accel_bias_sigma *
+                                                            o.init_accel_bias_sigma);
+  problem->AddResidualBlock(BiasPriorFactor::Create(Eigen::Matrix<double, 6, 1>::Zero(), bias_cov),
+                            nullptr, s->bias);
+}
+
+}  // namespace
+
+BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
+                        const std::vector<VisionFrame>& frames,
+                        const std::vector<ImuSample>& imu,
+                        const std::vector<StateRecord>& warm_start,
+                        const EstimatorOptions& estimator_options,
+                        const BatchSmootherOptions& options) {
+  if (!calibration.imu) throw std::invalid_argument("SmoothBatch: the calibration has no IMU");
+  BatchResult result;
+  ImuBuffer buffer(*calibration.imu, estimator_options.max_imu_gap_s);
+  for (const ImuSample& sample : imu) {
+    if (!buffer.Add(sample).empty()) ++result.stats.skipped_imu;
+  }
+  VisionRig rig;
+  rig.stereo_left = calibration.FindCameraByRole(CameraRole::kStereoLeft);
+  rig.mono = calibration.FindCameraByRole(CameraRole::kMono);
+  rig.dock = &dock;
+  std::map<int64_t, const VisionFrame*> frame_at;
+  for (const VisionFrame& f : frames) frame_at[f.t_ns] = &f;
+
+  // States from the warm start, strictly increasing in time.
+  std::vector<std::unique_ptr<BatchState>> states;
+  for (const StateRecord& r : warm_start) {
+    if (!states.empty() && r.t_ns <= states.back()->t_ns) continue;
+    auto s = std::make_unique<BatchState>();
+    s->t_ns = r.t_ns;
+    std::copy(r.pose, r.pose + kPoseSize, s->pose);
+    std::copy(r.velocity, r.velocity + kVelocitySize, s->velocity);
+    std::copy(r.bias, r.bias + kBiasSize, s->bias);
+    states.push_back(std::move(s));
+  }
+
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.enable_fast_removal = true;
+  ceres::Problem problem(problem_options);
+  const PoseManifold manifold;
+  for (size_t k = 0; k < states.size(); ++k) {
+    BatchState* s = states[k].get();
+    problem.AddParameterBlock(s->pose, kPoseSize, const_cast<PoseManifold*>(&manifold));
+    problem.AddParameterBlock(s->velocity, kVelocitySize);
+    problem.AddParameterBlock(s->bias, kBiasSize);
+    bool joined = false;
+    if (k > 0) {
+      BatchState* p = states[k - 1].get();
+      ImuBias bias;
+      bias.gyro = Eigen::Map<const Eigen::Vector3d>(p->bias);
+      bias.accel = Eigen::Map<const Eigen::Vector3d>(p->bias + 3);
+      const std::optional<ImuPreintegration> pim = buffer.Preintegrate(p->t_ns, s->t_ns, bias);
+      if (pim) {
+        problem.AddResidualBlock(ImuPreintegrationFactor::Create(*pim, dock.gravity_D), nullptr,
+                                 p->pose, p->velocity, p->bias, s->pose, s->velocity, s->bias);
+        joined = true;
+      }
+    }
+    if (!joined) {
+      AddInitialPriors(&problem, estimator_options, s);
+      ++result.segments;
+    }
+    const auto f = frame_at.find(s->t_ns);
+    if (f != frame_at.end()) {
+      s->vision = AddVisionFactors(&problem, *f->second, rig, estimator_options.vision, s->pose,
+                                   &result.stats.skipped_observations);
+    }
+  }
+  if (states.empty()) return result;
+
+  ceres::Solver::Options solver;
+  solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  solver.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  solver.max_num_iterations = options.max_iterations;
+  solver.num_threads = 1;
+  solver.logging_type = ceres::SILENT;
+  ProgressCallback callback(options.progress);
+  solver.callbacks.push_back(&callback);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver, &problem, &summary);
+  result.initial_cost = summary.initial_cost;
+  int gated = 0;
+  for (auto& s : states) {
+    s->n_gated = GateVisionResiduals(&problem, estimator_options.mono_gate_chi2,
+                                     estimator_options.stereo_gate_chi2, &s->vision);
+    gated += s->n_gated;
+  }
+  if (gated > 0) ceres::Solve(solver, &problem, &summary);
+  result.final_cost = summary.final_cost;
+  result.iterations = static_cast<int>(summary.iterations.size());
+  result.converged = summary.termination_type == ceres::CONVERGENCE;
+
+  // Marginal covariance of every pose.
+  ceres::Covariance::Options cov_options;
+  cov_options.algorithm_type = ceres::SPARSE_QR;
+  cov_options.num_threads = 1;
+  ceres::Covariance covariance(cov_options);
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (const auto& s : states) blocks.emplace_back(s->pose, s->pose);
+  const bool covariance_ok = covariance.Compute(blocks, &problem);
+
+  int64_t last_vision = INT64_MIN;
+  for (const auto& s : states) {
+    EstimatorOutput out;
+    out.t_ns = s->t_ns;
+    out.T_D_B = Pose3(Eigen::Map<const Eigen::Quaterniond>(s->pose + 3).normalized(),
+                      Eigen::Map<const Eigen::Vector3d>(s->pose));
+    out.v_D = Eigen::Map<const Eigen::Vector3d>(s->velocity);
+    out.bias.gyro = Eigen::Map<const Eigen::Vector3d>(s->bias);
+    out.bias.accel = Eigen::Map<const Eigen::Vector3d>(s->bias + 3);
+    for (const VisionResidual& r : s->vision) (r.mono ? out.n_mono : out.n_stereo) += 1;
+    out.n_gated = s->n_gated;
+    if (!s->vision.empty()) last_vision = s->t_ns;
+    out.seconds_since_vision =
+        last_vision == INT64_MIN ? -1.0 : 1e-9 * static_cast<double>(s->t_ns - last_vision);
+    if (covariance_ok) {
+      Eigen::Matrix<double, 6, 6, Eigen::RowMajor> cov;
+      if (covariance.GetCovarianceMatrixInTangentSpace({s->pose}, cov.data()) && cov.allFinite()) {
+        out.covariance = cov;
+        out.covariance_ok = true;
+      }
+    }
+    if (!out.covariance_ok) ++result.stats.covariance_failures;
+    const bool finite = out.T_D_B.p.allFinite() && out.T_D_B.q.coeffs().allFinite();
+    if (!finite) continue;  // never report a NaN pose
+    result.stats.used_observations += static_cast<int>(s->vision.size());
+    result.stats.gated_observations += s->n_gated;
+    result.outputs.push_back(out);
+  }
+  result.stats.frames = static_cast<int>(frames.size());
+  result.stats.frames_with_output = static_cast<int>(result.outputs.size());
+  return result;
+}
+
+}  // namespace auvdock

@@ -1,0 +1,49 @@
+#include "auvdock/estimator/estimator_config.h"
+
+#include "auvdock/io/yaml_config.h"
+
+namespace auvdock {
+
+RunConfig LoadRunConfig(const std::string& path) {
+  const ConfigNode root = ConfigNode::LoadFile(path);
+  RunConfig config;
+  EstimatorOptions& e = config.estimator;
+  const ConfigNode est = root.ChildOrEmpty("estimator");
+  e.window_size = est.GetInt("window_size", e.window_size);
+  if (e.window_size < 2) est.Fail("window_size", "must be at least 2");
+  e.max_solver_iterations = est.GetInt("max_solver_iterations", e.max_solver_iterations);
+  if (e.max_solver_iterations < 1) est.Fail("max_solver_iterations", "must be at least 1");
+  e.max_solver_time_s = est.GetNonNegative("max_solver_time_s", e.max_solver_time_s);
+  e.vision.huber_sigmas = est.GetPositive("huber_sigmas", e.vision.huber_sigmas);
+  e.mono_gate_chi2 = est.GetNonNegative("mono_gate_chi2", e.mono_gate_chi2);
+  e.stereo_gate_chi2 = est.GetNonNegative("stereo_gate_chi2", e.stereo_gate_chi2);
+  e.max_imu_gap_s = est.GetPositive("max_imu_gap_s", e.max_imu_gap_s);
+  e.vision.use_mono = est.GetBool("use_mono", e.vision.use_mono);
+  e.vision.use_stereo = est.GetBool("use_stereo", e.vision.use_stereo);
+  const std::string weighting = est.GetString("stage_weighting", "information");
+  if (!ParseStageWeightingMode(weighting, &e.vision.stage_weighting.mode)) {
+    est.Fail("stage_weighting",
+             "expected information or paper_light_count (got '" + weighting + "')");
+  }
+  e.vision.stage_weighting.min_share =
+      est.GetNonNegative("stage_min_share", e.vision.stage_weighting.min_share);
+  if (e.vision.stage_weighting.min_share > 0.5) est.Fail("stage_min_share", "must be at most 0.5");
+  e.init_position_sigma_m = est.GetPositive("init_position_sigma_m", e.init_position_sigma_m);
+  e.init_attitude_sigma_rad = est.GetPositive("init_attitude_sigma_rad", e.init_attitude_sigma_rad);
+  e.init_velocity_sigma_mps = est.GetPositive("init_velocity_sigma_mps", e.init_velocity_sigma_mps);
+  e.init_gyro_bias_sigma = est.GetPositive("init_gyro_bias_sigma", e.init_gyro_bias_sigma);
+  e.init_accel_bias_sigma = est.GetPositive("init_accel_bias_sigma", e.init_accel_bias_sigma);
+
+  GoNoGoOptions& g = config.go_no_go;
+  const ConfigNode go = root.ChildOrEmpty("go_no_go");
+  g.allowed_lateral_error_m = go.GetPositive("allowed_lateral_error_m", g.allowed_lateral_error_m);
+  g.max_yaw_3sigma_rad = go.GetPositive("max_yaw_3sigma_rad", g.max_yaw_3sigma_rad);
+  g.max_vision_age_s = go.GetPositive("max_vision_age_s", g.max_vision_age_s);
+  g.max_gating_rate = go.GetNonNegative("max_gating_rate", g.max_gating_rate);
+  g.gating_window_frames = go.GetInt("gating_window_frames", g.gating_window_frames);
+  if (g.gating_window_frames < 1) go.Fail("gating_window_frames", "must be at least 1");
+  root.CheckNoUnknownKeys();
+  return config;
+}
+
+}  // namespace auvdock

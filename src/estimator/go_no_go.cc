@@ -1,0 +1,71 @@
+#include "auvdock/estimator/go_no_go.h"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+
+namespace auvdock {
+namespace {
+
+std::string Format(const char* format, double a, double b) {
+  char buffer[160];
+  std::snprintf(buffer, sizeof(buffer), format, a, b);
+  return buffer;
+}
+
+}  // namespace
+
+GoNoGo::GoNoGo(const GoNoGoOptions& options) : options_(options) {
+  if (!(options_.allowed_lateral_error_m > 0.0) || !(options_.max_yaw_3sigma_rad > 0.0) ||
+      !(options_.max_vision_age_s > 0.0) || !(options_.max_gating_rate >= 0.0) ||
+      options_.gating_window_frames < 1) {
+    throw std::invalid_argument("GoNoGoOptions: thresholds must be positive");
+  }
+}
+
+GoNoGoDecision GoNoGo::NoEstimate(const std::string& reason) {
+  recent_.clear();
+  return {false, "no estimate: " + reason};
+}
+
+GoNoGoDecision GoNoGo::Decide(const EstimatorOutput& output) {
+  recent_.emplace_back(output.n_mono + output.n_stereo, output.n_gated);
+  while (static_cast<int>(recent_.size()) > options_.gating_window_frames) recent_.pop_front();
+
+  if (!output.covariance_ok || !output.covariance.allFinite()) {
+    return {false, "covariance unavailable (rank-deficient or not computed)"};
+  }
+  if (output.seconds_since_vision < 0.0) return {false, "no vision yet"};
+  if (output.seconds_since_vision > options_.max_vision_age_s) {
+    return {false, Format("no vision for %.2f s (limit %.2f s)", output.seconds_since_vision,
+                          options_.max_vision_age_s)};
+  }
+  int used = 0, gated = 0;
+  for (const auto& [u, g] : recent_) {
+    used += u;
+    gated += g;
+  }
+  const double rate = used + gated > 0 ? static_cast<double>(gated) / (used + gated) : 0.0;
+  if (rate > options_.max_gating_rate) {
+    return {false, Format("gating rate %.2f over the recent frames (limit %.2f)", rate,
+                          options_.max_gating_rate)};
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> horizontal(
+      output.covariance.topLeftCorner<2, 2>());
+  const double lateral_3sigma = 3.0 * std::sqrt(std::max(0.0, horizontal.eigenvalues().maxCoeff()));
+  if (lateral_3sigma > options_.allowed_lateral_error_m) {
+    return {false, Format("3-sigma lateral %.3f m > allowed %.3f m", lateral_3sigma,
+                          options_.allowed_lateral_error_m)};
+  }
+  const double yaw_3sigma = 3.0 * std::sqrt(std::max(0.0, output.covariance(5, 5)));
+  if (yaw_3sigma > options_.max_yaw_3sigma_rad) {
+    return {false, Format("3-sigma yaw %.4f rad > allowed %.4f rad", yaw_3sigma,
+                          options_.max_yaw_3sigma_rad)};
+  }
+  return {true, Format("3-sigma lateral %.3f m and yaw %.4f rad within limits", lateral_3sigma,
+                       yaw_3sigma)};
+}
+
+}  // namespace auvdock

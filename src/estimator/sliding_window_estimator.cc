@@ -1,0 +1,327 @@
+#include "auvdock/estimator/sliding_window_estimator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include <ceres/covariance.h>
+#include <ceres/problem.h>
+#include <ceres/solver.h>
+
+#include "auvdock/estimator/marginalization.h"
+#include "factors/bias_prior_factor.h"
+#include "factors/imu_preintegration_factor.h"
+#include "factors/marginalization_factor.h"
+#include "factors/pose_manifold.h"
+#include "factors/pose_prior_factor.h"
+#include "factors/velocity_prior_factor.h"
+
+namespace auvdock {
+namespace {
+
+constexpr double kNsPerSecond = 1e9;
+
+double Seconds(int64_t ns) { return static_cast<double>(ns) / kNsPerSecond; }
+
+void StorePose(const Pose3& T, double* pose) {
+  std::copy(T.p.data(), T.p.data() + 3, pose);
+  const Eigen::Quaterniond q = T.q.normalized();
+  std::copy(q.coeffs().data(), q.coeffs().data() + 4, pose + 3);
+}
+
+Pose3 LoadPose(const double* pose) {
+  return Pose3(Eigen::Map<const Eigen::Quaterniond>(pose + 3).normalized(),
+               Eigen::Map<const Eigen::Vector3d>(pose));
+}
+
+ImuBias LoadBias(const double* bias) {
+  ImuBias b;
+  b.gyro = Eigen::Map<const Eigen::Vector3d>(bias);
+  b.accel = Eigen::Map<const Eigen::Vector3d>(bias + 3);
+  return b;
+}
+
+}  // namespace
+
+struct SlidingWindowEstimator::State {
+  int64_t t_ns = 0;
+  double pose[kPoseSize] = {0, 0, 0, 0, 0, 0, 1};
+  double velocity[kVelocitySize] = {0, 0, 0};
+  double bias[kBiasSize] = {0, 0, 0, 0, 0, 0};
+  std::vector<VisionResidual> vision;  // this frame's vision residuals still in the problem
+  int n_gated = 0;
+};
+
+SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
+                                               const DockModel& dock,
+                                               const EstimatorOptions& options)
+    : calibration_(calibration),
+      dock_(dock),
+      options_(options),
+      pose_manifold_(std::make_unique<PoseManifold>()),
+      imu_(calibration.imu ? *calibration.imu : ImuCalibration(), options.max_imu_gap_s) {
+  if (options_.window_size < 2 || options_.max_solver_iterations < 1 ||
+      !(options_.vision.huber_sigmas > 0.0) || !(options_.max_imu_gap_s > 0.0) ||
+      options_.mono_gate_chi2 < 0.0 || options_.stereo_gate_chi2 < 0.0 ||
+      !(options_.init_position_sigma_m > 0.0) || !(options_.init_attitude_sigma_rad > 0.0) ||
+      !(options_.init_velocity_sigma_mps > 0.0) || !(options_.init_gyro_bias_sigma > 0.0) ||
+      !(options_.init_accel_bias_sigma > 0.0)) {
+    throw std::invalid_argument("EstimatorOptions: a size, sigma or gate is out of range");
+  }
+  if (!calibration_.imu) {
+    throw std::invalid_argument("SlidingWindowEstimator: the calibration has no IMU");
+  }
+  rig_.stereo_left = calibration_.FindCameraByRole(CameraRole::kStereoLeft);
+  rig_.mono = calibration_.FindCameraByRole(CameraRole::kMono);
+  rig_.dock = &dock_;
+  Reset("");
+  stats_.resets = 0;
+  stats_.log.clear();
+}
+
+SlidingWindowEstimator::~SlidingWindowEstimator() = default;
+
+void SlidingWindowEstimator::Reset(const std::string& reason) {
+  // The dropped states keep their last estimate in the history (the batch smoother's start).
+  for (const auto& state : window_) {
+    StateRecord record;
+    record.t_ns = state->t_ns;
+    std::copy(state->pose, state->pose + kPoseSize, record.pose);
+    std::copy(state->velocity, state->velocity + kVelocitySize, record.velocity);
+    std::copy(state->bias, state->bias + kBiasSize, record.bias);
+    history_.push_back(record);
+  }
+  window_.clear();
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  problem_options.enable_fast_removal = true;
+  problem_ = std::make_unique<ceres::Problem>(problem_options);
+  if (!reason.empty()) {
+    ++stats_.resets;
+    stats_.log.push_back("reset: " + reason);
+  }
+}
+
+void SlidingWindowEstimator::AddImu(const ImuSample& sample) {
+  const std::string problem = imu_.Add(sample);
+  if (!problem.empty()) {
+    ++stats_.skipped_imu;
+    stats_.log.push_back("imu sample at " + std::to_string(sample.t_ns) + " ns " + problem +
+                         ": skipped");
+    return;
+  }
+  ++stats_.imu_samples;
+  // Keep what the oldest state's interval needs (or the last second before initialisation).
+  imu_.DropBefore(window_.empty() ? sample.t_ns - static_cast<int64_t>(kNsPerSecond)
+                                  : window_.front()->t_ns);
+}
+
+bool SlidingWindowEstimator::Initialize(const VisionFrame& frame) {
+  if (!frame.T_D_B_initial) return false;
+  auto state = std::make_unique<State>();
+  state->t_ns = frame.t_ns;
+  StorePose(*frame.T_D_B_initial, state->pose);
+  problem_->AddParameterBlock(state->pose, kPoseSize, pose_manifold_.get());
+  problem_->AddParameterBlock(state->velocity, kVelocitySize);
+  problem_->AddParameterBlock(state->bias, kBiasSize);
+
+  Matrix6d pose_cov = Matrix6d::Zero();
+  pose_cov.topLeftCorner<3, 3>().diagonal().setConstant(std::pow(options_.init_position_sigma_m, 2));
+  pose_cov.bottomRightCorner<3, 3>().diagonal().setConstant(
+      std::pow(options_.init_attitude_sigma_rad, 2));
+  problem_->AddResidualBlock(PosePriorFactor::Create(*frame.T_D_B_initial, pose_cov), nullptr,
+                             state->pose);
+  problem_->AddResidualBlock(
+      VelocityPriorFactor::Create(Eigen::Vector3d::Zero(),
+                                  Eigen::Matrix3d::Identity() *
+                                      std::pow(options_.init_velocity_sigma_mps, 2)),
+      nullptr, state->velocity);
+  Matrix6d bias_cov = Matrix6d::Zero();
+  bias_cov.topLeftCorner<3, 3>().diagonal().setConstant(std::pow(options_.init_gyro_bias_sigma, 2));
+  bias_cov.bottomRightCorner<3, 3>().diagonal().setConstant(
+      std::pow(options_.init_accel_bias_sigma, 2));
+  problem_->AddResidualBlock(BiasPriorFactor::Create(Eigen::Matrix<double, 6, 1>::Zero(), bias_cov),
+                             nullptr, state->bias);
+  window_.push_back(std::move(state));
+  return true;
+}
+
+bool SlidingWindowEstimator::AddState(int64_t t_ns) {
+  State& previous = *window_.back();
+  const ImuBias bias = LoadBias(previous.bias);
+  const std::optional<ImuPreintegration> pim = imu_.Preintegrate(previous.t_ns, t_ns, bias);
+  if (!pim) return false;
+
+  auto state = std::make_unique<State>();
+  state->t_ns = t_ns;
+  NavState nav;
+  nav.q_D_B = LoadPose(previous.pose).q;
+  nav.p_D = LoadPose(previous.pose).p;
+  nav.v_D = Eigen::Map<const Eigen::Vector3d>(previous.velocity);
+  const NavState predicted = pim->Predict(nav, bias, dock_.gravity_D);
+  StorePose(Pose3(predicted.q_D_B, predicted.p_D), state->pose);
+  Eigen::Map<Eigen::Vector3d>(state->velocity) = predicted.v_D;
+  std::copy(previous.bias, previous.bias + kBiasSize, state->bias);
+
+  problem_->AddParameterBlock(state->pose, kPoseSize, pose_manifold_.get());
+  problem_->AddParameterBlock(state->velocity, kVelocitySize);
+  problem_->AddParameterBlock(state->bias, kBiasSize);
+  problem_->AddResidualBlock(ImuPreintegrationFactor::Create(*pim, dock_.gravity_D), nullptr,
+                             previous.pose, previous.velocity, previous.bias, state->pose,
+                             state->velocity, state->bias);
+  window_.push_back(std::move(state));
+  return true;
+}
+
+bool SlidingWindowEstimator::Solve() {
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  options.max_num_iterations = options_.max_solver_iterations;
+  if (options_.max_solver_time_s > 0.0) {
+    options.max_solver_time_in_seconds = options_.max_solver_time_s;
+  }
+  options.num_threads = 1;
+  options.logging_type = ceres::SILENT;
+  options.minimizer_progress_to_stdout = false;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, problem_.get(), &summary);
+  if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) return false;
+  for (const auto& state : window_) {
+    const bool finite = std::all_of(state->pose, state->pose + kPoseSize,
+                                    [](double x) { return std::isfinite(x); }) &&
+                        std::all_of(state->velocity, state->velocity + kVelocitySize,
+                                    [](double x) { return std::isfinite(x); }) &&
+                        std::all_of(state->bias, state->bias + kBiasSize,
+                                    [](double x) { return std::isfinite(x); });
+    if (!finite) return false;
+  }
+  return true;
+}
+
+void SlidingWindowEstimator::MarginalizeOldest() {
+  State& oldest = *window_.front();
+  StateRecord record;
+  record.t_ns = oldest.t_ns;
+  std::copy(oldest.pose, oldest.pose + kPoseSize, record.pose);
+  std::copy(oldest.velocity, oldest.velocity + kVelocitySize, record.velocity);
+  std::copy(oldest.bias, oldest.bias + kBiasSize, record.bias);
+  history_.push_back(record);
+
+  LinearizedPrior prior =
+      MarginalizeOut(problem_.get(), {oldest.pose, oldest.velocity, oldest.bias});
+  window_.pop_front();
+  if (!prior.blocks.empty()) {
+    auto* factor = new MarginalizationFactor(std::move(prior));
+    problem_->AddResidualBlock(factor, nullptr, factor->parameter_blocks());
+  }
+}
+
+EstimatorOutput SlidingWindowEstimator::Output(const State& state) {
+  EstimatorOutput out;
+  out.t_ns = state.t_ns;
+  out.T_D_B = LoadPose(state.pose);
+  out.v_D = Eigen::Map<const Eigen::Vector3d>(state.velocity);
+  out.bias = LoadBias(state.bias);
+  for (const VisionResidual& r : state.vision) (r.mono ? out.n_mono : out.n_stereo) += 1;
+  out.n_gated = state.n_gated;
+  out.seconds_since_vision =
+      last_vision_t_ns_ == INT64_MIN ? -1.0 : Seconds(state.t_ns - last_vision_t_ns_);
+  if (options_.compute_covariance) {
+    ceres::Covariance::Options cov_options;
+    cov_options.algorithm_type = ceres::SPARSE_QR;
+    cov_options.num_threads = 1;
+    cov_options.apply_loss_function = true;
+    ceres::Covariance covariance(cov_options);
+    const double* pose = state.pose;
+    std::vector<std::pair<const double*, const double*>> blocks = {{pose, pose}};
+    if (covariance.Compute(blocks, problem_.get())) {
+      Eigen::Matrix<double, 6, 6, Eigen::RowMajor> cov;
+      if (covariance.GetCovarianceMatrixInTangentSpace({pose}, cov.data()) && cov.allFinite()) {
+        out.covariance = cov;
+        out.covariance_ok = true;
+      }
+    }
+    if (!out.covariance_ok) {
+      ++stats_.covariance_failures;
+      stats_.log.push_back("covariance at " + std::to_string(state.t_ns) +
+                           " ns: rank-deficient, not reported");
+    }
+  }
+  return out;
+}
+
+std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const VisionFrame& frame) {
+  ++stats_.frames;
+  if (frame.t_ns <= last_frame_t_ns_) {
+    ++stats_.skipped_frames;
+    stats_.log.push_back("frame at " + std::to_string(frame.t_ns) +
+                         " ns out of order or repeated: skipped");
+    return std::nullopt;
+  }
+  last_frame_t_ns_ = frame.t_ns;
+
+  if (window_.empty()) {
+    if (!Initialize(frame)) return std::nullopt;
+  } else if (!AddState(frame.t_ns)) {
+    Reset("no IMU coverage (gap longer than " + std::to_string(options_.max_imu_gap_s) +
+          " s) up to " + std::to_string(frame.t_ns) + " ns");
+    if (!Initialize(frame)) return std::nullopt;
+  }
+  State* state = window_.back().get();
+  state->vision = AddVisionFactors(problem_.get(), frame, rig_, options_.vision, state->pose,
+                                   &stats_.skipped_observations);
+
+  if (!Solve()) {
+    ++stats_.solver_failures;
+    Reset("solver failed at " + std::to_string(frame.t_ns) + " ns");
+    return std::nullopt;
+  }
+  state->n_gated = GateVisionResiduals(problem_.get(), options_.mono_gate_chi2,
+                                       options_.stereo_gate_chi2, &state->vision);
+  if (state->n_gated > 0 && !Solve()) {
+    ++stats_.solver_failures;
+    Reset("solver failed at " + std::to_string(frame.t_ns) + " ns (after gating)");
+    return std::nullopt;
+  }
+  stats_.gated_observations += state->n_gated;
+  stats_.used_observations += static_cast<int>(state->vision.size());
+  if (!state->vision.empty()) last_vision_t_ns_ = frame.t_ns;
+  while (static_cast<int>(window_.size()) > options_.window_size) MarginalizeOldest();
+
+  EstimatorOutput out = Output(*state);
+  ++stats_.frames_with_output;
+  return out;
+}
+
+std::optional<Pose3> SlidingWindowEstimator::PropagatedPose(int64_t t_ns) const {
+  if (window_.empty()) return std::nullopt;
+  const State& newest = *window_.back();
+  if (t_ns < newest.t_ns) return std::nullopt;
+  if (t_ns == newest.t_ns) return LoadPose(newest.pose);
+  const ImuBias bias = LoadBias(newest.bias);
+  const std::optional<ImuPreintegration> pim = imu_.Preintegrate(newest.t_ns, t_ns, bias);
+  if (!pim) return std::nullopt;
+  NavState nav;
+  const Pose3 T = LoadPose(newest.pose);
+  nav.q_D_B = T.q;
+  nav.p_D = T.p;
+  nav.v_D = Eigen::Map<const Eigen::Vector3d>(newest.velocity);
+  const NavState predicted = pim->Predict(nav, bias, dock_.gravity_D);
+  return Pose3(predicted.q_D_B, predicted.p_D);
+}
+
+std::vector<StateRecord> SlidingWindowEstimator::History() const {
+  std::vector<StateRecord> all = history_;
+  for (const auto& state : window_) {
+    StateRecord record;
+    record.t_ns = state->t_ns;
+    std::copy(state->pose, state->pose + kPoseSize, record.pose);
+    std::copy(state->velocity, state->velocity + kVelocitySize, record.velocity);
+    std::copy(state->bias, state->bias + kBiasSize, record.bias);
+    all.push_back(record);
+  }
+  return all;
+}
+
+}  // namespace auvdock

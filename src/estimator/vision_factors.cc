@@ -1,0 +1,82 @@
+#include "auvdock/estimator/vision_factors.h"
+
+#include <cmath>
+
+#include <ceres/loss_function.h>
+
+#include "factors/mono_reprojection_factor.h"
+#include "factors/stereo_point_factor.h"
+
+namespace auvdock {
+namespace {
+
+ceres::LossFunction* WeightedHuber(double huber_sigmas, double weight) {
+  ceres::LossFunction* huber = new ceres::HuberLoss(huber_sigmas);
+  if (weight == 1.0) return huber;
+  return new ceres::ScaledLoss(huber, weight, ceres::TAKE_OWNERSHIP);
+}
+
+}  // namespace
+
+std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const VisionFrame& frame,
+                                             const VisionRig& rig,
+                                             const VisionFactorOptions& options, double* pose,
+                                             int* n_skipped) {
+  std::vector<VisionResidual> added;
+  const bool mono = options.use_mono && rig.mono != nullptr;
+  const bool stereo = options.use_stereo && rig.stereo_left != nullptr;
+  const int n_mono = mono ? static_cast<int>(frame.mono.size()) : 0;
+  const int n_stereo = stereo ? static_cast<int>(frame.stereo.size()) : 0;
+  const StageWeights weights = StageWeighting(options.stage_weighting).Compute(n_stereo, n_mono);
+  for (int i = 0; i < n_mono; ++i) {
+    const MonoLightObservation& obs = frame.mono[i];
+    const DockLight* light = rig.dock->FindLight(obs.light_id);
+    if (!light || !obs.uv.allFinite() || !std::isfinite(obs.sigma_px) || !(obs.sigma_px > 0.0)) {
+      ++*n_skipped;
+      continue;
+    }
+    const Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity() * obs.sigma_px * obs.sigma_px;
+    const ceres::ResidualBlockId id = problem->AddResidualBlock(
+        MonoReprojectionFactor::Create(obs.uv, covariance, rig.mono->intrinsics, rig.mono->T_B_C,
+                                       light->p_D),
+        WeightedHuber(options.huber_sigmas, weights.mono), pose);
+    added.push_back({id, true});
+  }
+  for (int i = 0; i < n_stereo; ++i) {
+    const StereoLightObservation& obs = frame.stereo[i];
+    const DockLight* light = rig.dock->FindLight(obs.light_id);
+    if (!light || !obs.p_S.allFinite() || !obs.covariance.allFinite() ||
+        Eigen::LLT<Eigen::Matrix3d>(obs.covariance).info() != Eigen::Success) {
+      ++*n_skipped;
+      continue;
+    }
+    const ceres::ResidualBlockId id = problem->AddResidualBlock(
+        StereoPointFactor::Create(obs.p_S, obs.covariance, rig.stereo_left->T_B_C, light->p_D),
+        WeightedHuber(options.huber_sigmas, weights.stereo), pose);
+    added.push_back({id, false});
+  }
+  return added;
+}
+
+int GateVisionResiduals(ceres::Problem* problem, double mono_gate_chi2, double stereo_gate_chi2,
+                        std::vector<VisionResidual>* residuals) {
+  int gated = 0;
+  std::vector<VisionResidual> kept;
+  for (const VisionResidual& residual : *residuals) {
+    double cost = 0.0;
+    // Without the loss and its stage weight, 2 cost is the squared Mahalanobis distance.
+    problem->EvaluateResidualBlock(residual.id, /*apply_loss_function=*/false, &cost, nullptr,
+                                   nullptr);
+    const double gate = residual.mono ? mono_gate_chi2 : stereo_gate_chi2;
+    if (gate > 0.0 && 2.0 * cost > gate) {
+      problem->RemoveResidualBlock(residual.id);
+      ++gated;
+    } else {
+      kept.push_back(residual);
+    }
+  }
+  *residuals = std::move(kept);
+  return gated;
+}
+
+}  // namespace auvdock

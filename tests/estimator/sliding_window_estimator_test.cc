@@ -1,0 +1,186 @@
+#include "auvdock/estimator/sliding_window_estimator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "auvdock/geometry/pose3.h"
+#include "tests/testing/synthetic_vision.h"
+#include "tests/testing/test_scenarios.h"
+
+namespace auvdock {
+namespace {
+
+// The default docking run's first 14 s (stereo only, then both camera systems), without images.
+test::SyntheticRun MakeRun(uint64_t seed) {
+  Scenario scenario = test::DefaultScenario();
+  scenario.duration_s = 14.0;
+  return test::MakeSyntheticRun(scenario, seed);
+}
+
+struct RunErrors {
+  double max_position_m = 0.0;
+  double max_attitude_rad = 0.0;
+  int outputs = 0;
+  double nees_sum = 0.0;
+  int nees_count = 0;
+};
+
+RunErrors RunEstimator(const test::SyntheticRun& run, SlidingWindowEstimator* estimator,
+                       double skip_first_s = 2.0) {
+  RunErrors errors;
+  size_t next_imu = 0;
+  const int64_t t_first = run.frames.front().t_ns;
+  for (size_t k = 0; k < run.frames.size(); ++k) {
+    const VisionFrame& frame = run.frames[k];
+    while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= frame.t_ns) {
+      estimator->AddImu(run.imu[next_imu++]);
+    }
+    const std::optional<EstimatorOutput> out = estimator->AddVisionFrame(frame);
+    if (!out) continue;
+    ++errors.outputs;
+    EXPECT_TRUE(out->T_D_B.p.allFinite());
+    if (1e-9 * static_cast<double>(frame.t_ns - t_first) < skip_first_s) continue;
+    const Pose3& truth = run.truth[k].T_D_B;
+    Eigen::Matrix<double, 6, 1> e;
+    e.head<3>() = out->T_D_B.p - truth.p;
+    const Eigen::AngleAxisd aa(out->T_D_B.q * truth.q.conjugate());
+    e.tail<3>() = aa.angle() * aa.axis();
+    errors.max_position_m = std::max(errors.max_position_m, e.head<3>().norm());
+    errors.max_attitude_rad = std::max(errors.max_attitude_rad, e.tail<3>().norm());
+    if (out->covariance_ok) {
+      errors.nees_sum += e.dot(out->covariance.ldlt().solve(e));
+      ++errors.nees_count;
+    }
+  }
+  return errors;
+}
+
+TEST(SlidingWindowEstimatorTest, RecoversTheTrajectoryFromPerturbedInitialPoses) {
+  const test::SyntheticRun run = MakeRun(1);
+  SlidingWindowEstimator estimator(run.calibration, run.dock);
+  const RunErrors errors = RunEstimator(run, &estimator);
+  std::printf("max position error %.4f m, attitude %.5f rad, mean NEES %.2f over %d\n",
+              errors.max_position_m, errors.max_attitude_rad,
+              errors.nees_sum / std::max(1, errors.nees_count), errors.nees_count);
+  EXPECT_GT(errors.outputs, 130);
+  EXPECT_LT(errors.max_position_m, 0.05);
+  EXPECT_LT(errors.max_attitude_rad, 0.02);
+  EXPECT_EQ(estimator.stats().resets, 0);
+  // Consistency: the mean NEES of the 6-DoF pose is near 6 (loose bounds for one run).
+  ASSERT_GT(errors.nees_count, 100);
+  const double mean_nees = errors.nees_sum / errors.nees_count;
+  EXPECT_GT(mean_nees, 1.5);
+  EXPECT_LT(mean_nees, 20.0);
+}
+
+TEST(SlidingWindowEstimatorTest, WaitsForAPerFramePoseBeforeInitialising) {
+  test::SyntheticRun run = MakeRun(2);
+  for (size_t k = 0; k < 5; ++k) run.frames[k].T_D_B_initial.reset();
+  SlidingWindowEstimator estimator(run.calibration, run.dock);
+  size_t next_imu = 0;
+  for (size_t k = 0; k < 6; ++k) {
+    while (run.imu[next_imu].t_ns <= run.frames[k].t_ns) estimator.AddImu(run.imu[next_imu++]);
+    const auto out = estimator.AddVisionFrame(run.frames[k]);
+    EXPECT_EQ(out.has_value(), k == 5) << k;
+  }
+}
+
+TEST(SlidingWindowEstimatorTest, SkipsBadMeasurementsAndSaysSo) {
+  const test::SyntheticRun run = MakeRun(3);
+  SlidingWindowEstimator estimator(run.calibration, run.dock);
+  size_t next_imu = 0;
+  for (size_t k = 0; k < 30; ++k) {
+    VisionFrame frame = run.frames[k];
+    while (run.imu[next_imu].t_ns <= frame.t_ns) {
+      ImuSample s = run.imu[next_imu++];
+      if (next_imu % 50 == 0) s.accel.x() = std::numeric_limits<double>::quiet_NaN();
+      estimator.AddImu(s);
+      if (next_imu % 70 == 0) estimator.AddImu(s);  // repeated
+    }
+    if (k == 10 && !frame.stereo.empty()) frame.stereo[0].p_S.x() = std::nan("");
+    if (k == 12 && !frame.stereo.empty()) frame.stereo[0].light_id = 999;  // not on the dock
+    const auto out = estimator.AddVisionFrame(frame);
+    if (out) {
+      EXPECT_TRUE(out->T_D_B.p.allFinite());
+      EXPECT_TRUE(out->T_D_B.q.coeffs().allFinite());
+    }
+    if (k == 20) EXPECT_FALSE(estimator.AddVisionFrame(frame).has_value());  // repeated frame
+  }
+  const EstimatorStats& stats = estimator.stats();
+  EXPECT_GT(stats.skipped_imu, 5);
+  EXPECT_EQ(stats.skipped_frames, 1);
+  EXPECT_EQ(stats.skipped_observations, 2);
+  EXPECT_FALSE(stats.log.empty());
+  EXPECT_EQ(stats.resets, 0);
+}
+
+TEST(SlidingWindowEstimatorTest, AnImuGapResetsAndTheNextPerFramePoseRestarts) {
+  const test::SyntheticRun run = MakeRun(4);
+  SlidingWindowEstimator estimator(run.calibration, run.dock);
+  size_t next_imu = 0;
+  int outputs_after_gap = 0;
+  for (size_t k = 0; k < 40; ++k) {
+    const VisionFrame& frame = run.frames[k];
+    while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= frame.t_ns) {
+      const ImuSample& s = run.imu[next_imu++];
+      // Drop 0.5 s of IMU between frames 20 and 25.
+      if (k >= 20 && k < 25) continue;
+      estimator.AddImu(s);
+    }
+    const auto out = estimator.AddVisionFrame(frame);
+    if (k >= 26 && out) ++outputs_after_gap;
+  }
+  EXPECT_GE(estimator.stats().resets, 1);
+  EXPECT_GT(outputs_after_gap, 10);
+}
+
+TEST(SlidingWindowEstimatorTest, CarriesOnOnTheImuWithoutVisionAndTheCovarianceGrows) {
+  test::SyntheticRun run = MakeRun(5);
+  SlidingWindowEstimator estimator(run.calibration, run.dock);
+  size_t next_imu = 0;
+  double sigma_before = 0.0, sigma_after = 0.0;
+  int outputs_blind = 0;
+  for (size_t k = 0; k < 60; ++k) {
+    VisionFrame frame = run.frames[k];
+    if (k >= 40) {  // the cameras go blind for 2 s
+      frame.mono.clear();
+      frame.stereo.clear();
+      frame.T_D_B_initial.reset();
+    }
+    while (run.imu[next_imu].t_ns <= frame.t_ns) estimator.AddImu(run.imu[next_imu++]);
+    const auto out = estimator.AddVisionFrame(frame);
+    ASSERT_TRUE(out.has_value()) << k;
+    ASSERT_TRUE(out->covariance_ok) << k;
+    if (k == 39) sigma_before = std::sqrt(out->covariance.topLeftCorner<3, 3>().trace());
+    if (k == 59) sigma_after = std::sqrt(out->covariance.topLeftCorner<3, 3>().trace());
+    if (k >= 40) ++outputs_blind;
+  }
+  EXPECT_EQ(outputs_blind, 20);
+  EXPECT_GT(sigma_after, 2.0 * sigma_before);
+  // Propagation at IMU rate beyond the newest state.
+  const auto propagated = estimator.PropagatedPose(run.frames[59].t_ns + 20'000'000);
+  EXPECT_TRUE(propagated.has_value());
+}
+
+TEST(SlidingWindowEstimatorTest, HistoryHoldsEveryStateOnce) {
+  const test::SyntheticRun run = MakeRun(6);
+  EstimatorOptions options;
+  options.window_size = 5;
+  SlidingWindowEstimator estimator(run.calibration, run.dock, options);
+  size_t next_imu = 0;
+  int outputs = 0;
+  for (size_t k = 0; k < 30; ++k) {
+    while (run.imu[next_imu].t_ns <= run.frames[k].t_ns) estimator.AddImu(run.imu[next_imu++]);
+    outputs += estimator.AddVisionFrame(run.frames[k]).has_value();
+  }
+  const std::vector<StateRecord> history = estimator.History();
+  EXPECT_EQ(static_cast<int>(history.size()), outputs);
+  for (size_t i = 1; i < history.size(); ++i) EXPECT_LT(history[i - 1].t_ns, history[i].t_ns);
+}
+
+}  // namespace
+}  // namespace auvdock

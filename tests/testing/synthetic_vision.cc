@@ -1,0 +1,81 @@
+#include "tests/testing/synthetic_vision.h"
+
+#include "auvdock/sim/docking_simulator.h"
+#include "auvdock/sim/imu_simulator.h"
+#include "auvdock/sim/random_stream.h"
+#include "auvdock/vision/stereo_triangulation.h"
+
+namespace auvdock::test {
+namespace {
+
+// The noisy pixel of a dock light in a camera, if the camera sees it (in front, in the image,
+// within range, the camera above the light's deck so that the light faces it).
+std::optional<Eigen::Vector2d> See(const CameraCalibration& camera, const Pose3& T_D_B,
+                                   const Eigen::Vector3d& p_D, double sigma, std::mt19937_64& rng) {
+  const Pose3 T_D_C = T_D_B * camera.T_B_C;
+  if (T_D_C.p.z() >= p_D.z() || (T_D_C.p - p_D).norm() > 15.0) return std::nullopt;
+  const Eigen::Vector3d p_C = T_D_C.Inverse() * p_D;
+  if (p_C.z() < 0.3) return std::nullopt;
+  const std::optional<Eigen::Vector2d> uv = camera.intrinsics.Project(p_C);
+  if (!uv || !camera.intrinsics.InImage(*uv, 3.0)) return std::nullopt;
+  const double nu = StandardNormal(rng), nv = StandardNormal(rng);
+  return *uv + sigma * Eigen::Vector2d(nu, nv);
+}
+
+}  // namespace
+
+SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed, double pixel_sigma) {
+  const DockingSimulator simulator(scenario);
+  SyntheticRun run;
+  run.calibration = simulator.calibration();
+  run.dock = scenario.dock;
+  const CameraCalibration* left = run.calibration.FindCameraByRole(CameraRole::kStereoLeft);
+  const CameraCalibration* right = run.calibration.FindCameraByRole(CameraRole::kStereoRight);
+  const CameraCalibration* mono = run.calibration.FindCameraByRole(CameraRole::kMono);
+  for (CameraCalibration& camera : run.calibration.cameras) camera.pixel_noise_px = pixel_sigma;
+
+  ImuSimulator imu(scenario.imu, scenario.dock.gravity_D, scenario.initial_gyro_bias,
+                   scenario.initial_accel_bias, true, MakeRandomStream(seed, 101));
+  for (int64_t k = 0;; ++k) {
+    const int64_t t = simulator.SampleTime(k, scenario.imu.rate_hz);
+    if (simulator.Seconds(t) > scenario.duration_s) break;
+    run.imu.push_back(imu.Sample(t, simulator.trajectory().At(simulator.Seconds(t))));
+  }
+
+  std::mt19937_64 rng = MakeRandomStream(seed, 102);
+  const double rate = left ? left->rate_hz : mono->rate_hz;
+  for (int64_t k = 0;; ++k) {
+    const int64_t t = simulator.SampleTime(k, rate);
+    if (simulator.Seconds(t) > scenario.duration_s) break;
+    const Pose3 T_D_B = simulator.trajectory().At(simulator.Seconds(t)).T_D_B;
+    VisionFrame frame;
+    frame.t_ns = t;
+    for (const DockLight& light : run.dock.lights) {
+      if (mono) {
+        if (const auto uv = See(*mono, T_D_B, light.p_D, pixel_sigma, rng)) {
+          frame.mono.push_back({light.id, *uv, pixel_sigma});
+        }
+      }
+      if (left && right) {
+        const auto uv_left = See(*left, T_D_B, light.p_D, pixel_sigma, rng);
+        const auto uv_right = See(*right, T_D_B, light.p_D, pixel_sigma, rng);
+        if (uv_left && uv_right) {
+          const TriangulatedPoint p =
+              TriangulateLinear(*uv_left, *uv_right, *left, *right, pixel_sigma);
+          if (p.ok) frame.stereo.push_back({light.id, p.p_S, p.covariance});
+        }
+      }
+    }
+    if (frame.mono.size() >= 3 || frame.stereo.size() >= 3) {
+      const Eigen::Vector3d dp = 0.05 * StandardNormal3(rng);
+      const Eigen::Vector3d dtheta = 0.02 * StandardNormal3(rng);
+      const Eigen::Quaterniond dq(Eigen::AngleAxisd(dtheta.norm(), dtheta.normalized()));
+      frame.T_D_B_initial = Pose3(dq * T_D_B.q, T_D_B.p + dp);
+    }
+    run.frames.push_back(frame);
+    run.truth.push_back({t, T_D_B});
+  }
+  return run;
+}
+
+}  // namespace auvdock::test

@@ -1,0 +1,30 @@
+// A docking run without images: the scenario's trajectory, its simulated IMU (noise and bias
+// walk on) and, at every camera frame, the identified lights a perfect front-end would report
+// with Gaussian pixel noise: mono pixels of the lights the mono camera sees, and stereo lights
+// seen by both stereo cameras, triangulated from noisy pixels (with their covariance). The
+// per-frame initial pose is the truth perturbed by a few centimetres / degrees when a camera
+// system sees at least 3 lights. For estimator tests and NEES runs (fast: no rendering).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "auvdock/estimator/vision_frame.h"
+#include "auvdock/geometry/stamped_pose.h"
+#include "auvdock/io/calibration.h"
+#include "auvdock/io/measurements.h"
+#include "auvdock/sim/scenario.h"
+
+namespace auvdock::test {
+
+struct SyntheticRun {
+  Calibration calibration;
+  DockModel dock;
+  std::vector<ImuSample> imu;
+  std::vector<VisionFrame> frames;
+  std::vector<StampedPose> truth;  // body pose at each frame
+};
+
+SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed, double pixel_sigma = 0.3);
+
+}  // namespace auvdock::test
