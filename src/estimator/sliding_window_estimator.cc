@@ -176,7 +176,8 @@ bool SlidingWindowEstimator::AddState(int64_t t_ns) {
 
 bool SlidingWindowEstimator::Solve() {
   ceres::Solver::Options options;
-  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
   options.max_num_iterations = options_.max_solver_iterations;
   if (options_.max_solver_time_s > 0.0) {
     options.max_solver_time_in_seconds = options_.max_solver_time_s;

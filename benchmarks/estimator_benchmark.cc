@@ -1,0 +1,64 @@
+// Speed of the sliding-window estimator on the default docking run (40 s, 401 frames at 10 Hz,
+// IMU at 200 Hz), fed with the identified lights a perfect front-end would report (noise
+// 0.3 px; tests/testing/synthetic_vision.h), so that only the back-end is timed.
+// Per iteration: the whole run. Counters: median and p99 of the per-frame update (IMU samples
+// of the frame + AddVisionFrame: preintegrate, solve, gate, marginalize, covariance) and the
+// back-end's speed as a multiple of real time.
+// Budget (issue 4): window update p99 <= 5 ms with a window of 10; back-end >= 50x real time.
+#include <algorithm>
+#include <chrono>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "auvdock/estimator/sliding_window_estimator.h"
+#include "tests/testing/synthetic_vision.h"
+#include "tests/testing/test_scenarios.h"
+
+namespace auvdock {
+namespace {
+
+const test::SyntheticRun& DefaultRun() {
+  static const test::SyntheticRun run = test::MakeSyntheticRun(test::DefaultScenario(), 1);
+  return run;
+}
+
+void RunWindow(benchmark::State& state, bool covariance, int window) {
+  const test::SyntheticRun& run = DefaultRun();
+  EstimatorOptions options;
+  options.compute_covariance = covariance;
+  options.window_size = window;
+  std::vector<double> update_ms;
+  double total_s = 0.0;
+  for (auto _ : state) {
+    SlidingWindowEstimator estimator(run.calibration, run.dock, options);
+    size_t next_imu = 0;
+    update_ms.clear();
+    const auto start = std::chrono::steady_clock::now();
+    for (const VisionFrame& frame : run.frames) {
+      const auto t0 = std::chrono::steady_clock::now();
+      while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= frame.t_ns) {
+        estimator.AddImu(run.imu[next_imu++]);
+      }
+      benchmark::DoNotOptimize(estimator.AddVisionFrame(frame));
+      update_ms.push_back(
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+    total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  std::sort(update_ms.begin(), update_ms.end());
+  const double duration_s =
+      1e-9 * static_cast<double>(run.frames.back().t_ns - run.frames.front().t_ns);
+  state.counters["median_ms"] = update_ms[update_ms.size() / 2];
+  state.counters["p99_ms"] = update_ms[static_cast<size_t>(0.99 * (update_ms.size() - 1))];
+  state.counters["max_ms"] = update_ms.back();
+  state.counters["x_realtime"] = duration_s / total_s;
+}
+
+void BM_WindowUpdate(benchmark::State& state) { RunWindow(state, true, 10); }
+void BM_WindowUpdateNoCovariance(benchmark::State& state) { RunWindow(state, false, 10); }
+BENCHMARK(BM_WindowUpdate)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_WindowUpdateNoCovariance)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace
+}  // namespace auvdock

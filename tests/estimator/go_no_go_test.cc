@@ -1,0 +1,87 @@
+#include "auvdock/estimator/go_no_go.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+namespace auvdock {
+namespace {
+
+using ::testing::HasSubstr;
+
+EstimatorOutput PreciseOutput() {
+  EstimatorOutput out;
+  out.covariance_ok = true;
+  out.covariance = Matrix6d::Identity() * 1e-6;  // 1 mm, 1 mrad
+  out.n_mono = 6;
+  out.seconds_since_vision = 0.0;
+  return out;
+}
+
+TEST(GoNoGoTest, PreciseHealthyEstimateIsGo) {
+  GoNoGo decide;
+  const GoNoGoDecision d = decide.Decide(PreciseOutput());
+  EXPECT_TRUE(d.go) << d.reason;
+}
+
+TEST(GoNoGoTest, LateralThreeSigmaUsesTheMajorAxisOfTheHorizontalCovariance) {
+  GoNoGoOptions options;
+  options.allowed_lateral_error_m = 0.10;
+  GoNoGo decide(options);
+  EstimatorOutput out = PreciseOutput();
+  // sigma_x = sigma_y = 0.02 m but fully correlated: the major axis is 0.02 sqrt(2) = 0.028 m,
+  // 3 sigma = 0.085 m: GO; at 0.025 m per axis it is 0.106 m: NO-GO.
+  out.covariance.topLeftCorner<2, 2>() << 4e-4, 4e-4, 4e-4, 4e-4;
+  EXPECT_TRUE(decide.Decide(out).go);
+  out.covariance.topLeftCorner<2, 2>() << 6.25e-4, 6.25e-4, 6.25e-4, 6.25e-4;
+  const GoNoGoDecision d = decide.Decide(out);
+  EXPECT_FALSE(d.go);
+  EXPECT_THAT(d.reason, HasSubstr("3-sigma lateral 0.106 m"));
+}
+
+TEST(GoNoGoTest, YawUncertaintyAboveTheLimitIsNoGo) {
+  GoNoGo decide;
+  EstimatorOutput out = PreciseOutput();
+  out.covariance(5, 5) = 0.02 * 0.02;  // 3 sigma = 0.06 rad > 0.05
+  const GoNoGoDecision d = decide.Decide(out);
+  EXPECT_FALSE(d.go);
+  EXPECT_THAT(d.reason, HasSubstr("yaw"));
+}
+
+TEST(GoNoGoTest, StaleVisionMissingCovarianceAndNoEstimateAreNoGo) {
+  GoNoGo decide;
+  EstimatorOutput stale = PreciseOutput();
+  stale.seconds_since_vision = 2.0;
+  EXPECT_THAT(decide.Decide(stale).reason, HasSubstr("no vision for 2.00 s"));
+  EstimatorOutput never = PreciseOutput();
+  never.seconds_since_vision = -1.0;
+  EXPECT_FALSE(decide.Decide(never).go);
+  EstimatorOutput singular = PreciseOutput();
+  singular.covariance_ok = false;
+  EXPECT_THAT(decide.Decide(singular).reason, HasSubstr("covariance unavailable"));
+  EXPECT_FALSE(decide.NoEstimate("reset").go);
+}
+
+TEST(GoNoGoTest, ManyGatedResidualsInRecentFramesAreNoGo) {
+  GoNoGoOptions options;
+  options.max_gating_rate = 0.3;
+  options.gating_window_frames = 4;
+  GoNoGo decide(options);
+  EstimatorOutput out = PreciseOutput();
+  out.n_mono = 4;
+  out.n_gated = 2;  // 2 of 6 = 0.33 per frame
+  const GoNoGoDecision d = decide.Decide(out);
+  EXPECT_FALSE(d.go);
+  EXPECT_THAT(d.reason, HasSubstr("gating rate 0.33"));
+  // Four clean frames push the gated one out of the window.
+  for (int i = 0; i < 3; ++i) decide.Decide(PreciseOutput());
+  EXPECT_TRUE(decide.Decide(PreciseOutput()).go);
+}
+
+TEST(GoNoGoTest, RejectsNonPositiveThresholds) {
+  GoNoGoOptions options;
+  options.allowed_lateral_error_m = 0.0;
+  EXPECT_THROW(GoNoGo{options}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace auvdock
