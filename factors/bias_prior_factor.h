@@ -10,9 +10,9 @@
 
 #include <stdexcept>
 
+#include <ceres/autodiff_cost_function.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
-#include <ceres/autodiff_cost_function.h>
 
 #include "factors/pose_manifold.h"
 

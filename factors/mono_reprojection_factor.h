@@ -37,10 +37,10 @@
 #include <limits>
 #include <stdexcept>
 
+#include <ceres/autodiff_cost_function.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <ceres/autodiff_cost_function.h>
 
 #include "auvdock/camera/pinhole_radtan_camera.h"
 #include "auvdock/geometry/pose3.h"
@@ -74,7 +74,7 @@ class MonoReprojectionFactor {
         p_D_L_(p_D_L),
         information_weight_(information_weight) {
     if (!uv_.allFinite() || !p_D_L_.allFinite() || !T_B_C_.p.allFinite() ||
-        !T_B_C_.q.coeffs().allFinite()) {
+        !T_B_C_.q.coeffs().allFinite() || !(T_B_C_.q.norm() > 0.0)) {
       throw std::invalid_argument("MonoReprojectionFactor: non-finite measurement or constant");
     }
     if (!(fx_ > 0.0) || !(fy_ > 0.0) || !std::isfinite(fx_) || !std::isfinite(fy_) ||

@@ -9,18 +9,19 @@
 //   e = Minus(T_D_B, T_D_B0) = [ p - p0 ;  Log(q q0^-1) ]        m, rad
 //   r = sqrt_info e,   sqrt_info^T sqrt_info = Sigma^-1          (factored once here)
 // Log takes the shorter of q and -q (angle in [0, pi]), so the sign of the stored quaternion
-// does not matter. At T_D_B = T_D_B0 the Jacobian with respect to the tangent step is sqrt_info
-// itself (MinusJacobian * PlusJacobian = I).
-// Source: the standard Gaussian prior of a least-squares estimator (no paper-specific form).
+// does not matter; the price is a jump where the error angle crosses pi (q q0^-1 changes side),
+// so a prior is only meaningful well inside that (any sensible covariance is). At T_D_B = T_D_B0
+// the Jacobian with respect to the tangent step is sqrt_info itself (MinusJacobian * PlusJacobian =
+// I). Source: the standard Gaussian prior of a least-squares estimator (no paper-specific form).
 #pragma once
 
 #include <cmath>
 #include <stdexcept>
 
+#include <ceres/autodiff_cost_function.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <ceres/autodiff_cost_function.h>
 
 #include "auvdock/geometry/pose3.h"
 #include "factors/pose_manifold.h"

@@ -31,10 +31,10 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <ceres/autodiff_cost_function.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <ceres/autodiff_cost_function.h>
 
 #include "auvdock/geometry/pose3.h"
 #include "factors/pose_manifold.h"
@@ -58,15 +58,14 @@ class StereoPointFactor {
         p_D_L_(p_D_L),
         information_weight_(information_weight) {
     if (!p_S_.allFinite() || !p_D_L_.allFinite() || !T_B_S_.p.allFinite() ||
-        !T_B_S_.q.coeffs().allFinite()) {
+        !T_B_S_.q.coeffs().allFinite() || !(T_B_S_.q.norm() > 0.0)) {
       throw std::invalid_argument("StereoPointFactor: non-finite measurement or constant");
     }
     if (!(information_weight_ > 0.0) || !std::isfinite(information_weight_)) {
       throw std::invalid_argument("StereoPointFactor: information_weight must be > 0");
     }
-    if (!covariance_S_.allFinite() ||
-        !(covariance_S_ - covariance_S_.transpose())
-             .isZero(1e-9 * covariance_S_.cwiseAbs().maxCoeff())) {
+    if (!covariance_S_.allFinite() || !(covariance_S_ - covariance_S_.transpose())
+                                           .isZero(1e-9 * covariance_S_.cwiseAbs().maxCoeff())) {
       throw std::invalid_argument("StereoPointFactor: covariance is not finite and symmetric");
     }
     // Sigma = L L^T  =>  Sigma^-1 = L^-T L^-1, so sqrt_info = L^-1.
@@ -103,8 +102,7 @@ class StereoPointFactor {
                                      const Eigen::Matrix3d& covariance_S, const Pose3& T_B_S,
                                      const Eigen::Vector3d& p_D_L,
                                      double information_weight = 1.0) {
-    return new ceres::AutoDiffCostFunction<StereoPointFactor, kStereoPointResidualSize,
-                                           kPoseSize>(
+    return new ceres::AutoDiffCostFunction<StereoPointFactor, kStereoPointResidualSize, kPoseSize>(
         new StereoPointFactor(p_S, covariance_S, T_B_S, p_D_L, information_weight));
   }
 

@@ -49,8 +49,8 @@ StageWeights StageWeighting::Compute(int n_stereo, int n_mono) const {
   const double n_s = n_stereo;
   const double n_m = n_mono;
   const double n = n_s + n_m;
-  const double share_s = std::max(n_s / n, options_.min_share);
-  const double share_m = std::max(n_m / n, options_.min_share);
+  const double share_s = std::clamp(n_s / n, options_.min_share, 1.0 - options_.min_share);
+  const double share_m = 1.0 - share_s;
   // Keep the per-light mean weight at 1: n_s w_s + n_m w_m = n_s + n_m.
   const double c = n / (n_s * share_s + n_m * share_m);
   weights.stereo = c * share_s;

@@ -11,8 +11,9 @@
 //
 // Modes:
 //   kInformation (default): w_s = w_m = 1. Every residual is weighted by its own noise model.
-//   kPaperLightCount: the paper's shares s_i = n_i / (n_s + n_m), raised to at least min_share,
-//     times one factor c chosen so that the weights do not shrink the total information:
+//   kPaperLightCount: the paper's split s_s = n_s / (n_s + n_m), s_m = 1 - s_s, with s_s clamped
+//     to [min_share, 1 - min_share], times one factor c chosen so that the weights do not shrink
+//     the total information:
 //       c = (n_s + n_m) / (n_s s_s + n_m s_m),   w_i = c s_i,
 //     i.e. n_s w_s + n_m w_m = n_s + n_m - the mean weight per light is 1, as in kInformation,
 //     and only the split between the two systems changes (w_s / w_m = s_s / s_m). With min_share
@@ -52,9 +53,9 @@ bool ParseStageWeightingMode(const std::string& text, StageWeightingMode* mode);
 
 struct StageWeightingOptions {
   StageWeightingMode mode = StageWeightingMode::kInformation;
-  // kPaperLightCount only: the smallest share n_i / (n_s + n_m) a system that sees at least one
-  // light gets before renormalisation, in [0, 0.5]. 0 is the paper's rule; a positive floor keeps
-  // a system that sees one light from being silenced.
+  // kPaperLightCount only: the smallest share of the split a system that sees at least one light
+  // gets (the other gets 1 - share), in [0, 0.5]. 0 is the paper's rule; a positive floor keeps a
+  // system that sees one light from being silenced; 0.5 gives both systems weight 1.
   double min_share = 0.0;
 };
 
