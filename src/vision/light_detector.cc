@@ -20,12 +20,13 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr int kSaturatedLevel = 250;
 constexpr int kFullScale = 255;
 
-// Per-channel background on a coarse grid: block means, then a grey opening (erosion followed by
+// Per-channel background on a coarse grid: block means, a grey closing that fills dark structures
+// narrower than close_cells (the lights' dark housings), then a grey opening (erosion followed by
 // dilation) that removes every bright structure narrower than the window, then a 3 x 3 mean.
 // Sampled bilinearly at full-resolution pixel centres.
 class CoarseBackground {
  public:
-  CoarseBackground(const cv::Mat& image, int grid_cols, int window_cells) {
+  CoarseBackground(const cv::Mat& image, int grid_cols, int close_cells, int window_cells) {
     cols_ = std::max(2, std::min(grid_cols, image.cols));
     cell_x_ = static_cast<double>(image.cols) / cols_;
     rows_ = std::max(2, static_cast<int>(std::lround(image.rows / cell_x_)));
@@ -36,6 +37,10 @@ class CoarseBackground {
     coarse.convertTo(coarse, CV_32F);
     const int w = std::max(1, window_cells);
     const cv::Mat square = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(w, w));
+    if (close_cells > 1) {
+      cv::morphologyEx(coarse, coarse, cv::MORPH_CLOSE,
+                       cv::getStructuringElement(cv::MORPH_RECT, cv::Size(close_cells, close_cells)));
+    }
     cv::morphologyEx(coarse, coarse, cv::MORPH_OPEN, square);
     cv::blur(coarse, coarse, cv::Size(3, 3), cv::Point(-1, -1), cv::BORDER_REPLICATE);
     cv::split(coarse, planes_);
@@ -104,9 +109,17 @@ int FindRoot(std::vector<Region>& regions, int r) {
   return r;
 }
 
+// Pixel coordinates packed into one word, x in the low and y in the high 16 bits (Detect
+// refuses larger images): pixel lists then need no division to recover a coordinate.
+inline uint32_t Pack(int x, int y) {
+  return (static_cast<uint32_t>(y) << 16) | static_cast<uint32_t>(x);
+}
+inline int PackedX(uint32_t p) { return static_cast<int>(p & 0xFFFFu); }
+inline int PackedY(uint32_t p) { return static_cast<int>(p >> 16); }
+
 // A blob before the fit: its pixels and first measurements.
 struct Blob {
-  std::vector<int> pixels;  // linear indices at the blob's scale, brightest (smoothed) first
+  std::vector<uint32_t> pixels;  // packed coordinates at the blob's scale, brightest first
   int scale = 1;            // pixels are on a grid downsampled by this factor
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // bounding box at full resolution, inclusive
   bool at_border = false;
@@ -130,55 +143,64 @@ struct Blob {
 // highest peak; a region that rises less than min_prominence above the level at which it meets a
 // brighter one is absorbed by it (a shoulder, e.g. a merged reflection, or a noise bump),
 // otherwise it stays a separate blob. Linear time (counting sort on 8-bit levels).
-void SplitComponent(const cv::Mat& smoothed, const std::vector<int>& component, int bx, int by,
-                    int bw, int bh, double min_prominence, std::vector<Blob>* blobs) {
-  const int cols = smoothed.cols;
-  const uint8_t* data = smoothed.data;  // continuous
+void SplitComponent(const cv::Mat& smoothed, const std::vector<uint32_t>& component, int bx,
+                    int by, int bw, int bh, double min_prominence, std::vector<Blob>* blobs) {
+  // The component's levels, in its own order, then a stable counting sort by descending level.
+  std::vector<uint8_t> levels(component.size());
+  for (size_t i = 0; i < component.size(); ++i) {
+    levels[i] = smoothed.ptr<uint8_t>(PackedY(component[i]))[PackedX(component[i])];
+  }
   std::array<int, kFullScale + 2> start{};
-  for (int index : component) ++start[kFullScale - data[index] + 1];
+  for (uint8_t level : levels) ++start[kFullScale - level + 1];
   std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<int> order(component.size());
-  for (int index : component) order[start[kFullScale - data[index]]++] = index;
+  std::vector<uint32_t> order(component.size());
+  std::vector<uint8_t> order_level(component.size());
+  for (size_t i = 0; i < component.size(); ++i) {
+    const int k = start[kFullScale - levels[i]]++;
+    order[k] = component[i];
+    order_level[k] = levels[i];
+  }
 
-  std::vector<int> region_of(static_cast<size_t>(bw) * bh, -1);  // -1: not visited yet
+  // Region ids on the bounding box with a one-pixel border, -1 where not visited (yet): only this
+  // component's pixels are ever visited, so an id >= 0 means "same component".
+  const int pw = bw + 2;
+  std::vector<int> region_of(static_cast<size_t>(pw) * (bh + 2), -1);
   std::vector<Region> regions;
-  for (int index : order) {
-    const int x = index % cols - bx;
-    const int y = index / cols - by;
-    const int level = data[index];
-    // Regions of the already visited neighbours (only this component's pixels are ever
-    // visited, so an id >= 0 means "same component"); neighbours mostly share one id, so the
-    // ids are deduplicated before their roots are looked up.
-    std::array<int, 8> ids;
-    int num_ids = 0;
-    for (int dy = -1; dy <= 1; ++dy) {
-      const int yy = y + dy;
-      if (yy < 0 || yy >= bh) continue;
-      const int* row = &region_of[yy * bw];
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int xx = x + dx;
-        if ((dx == 0 && dy == 0) || xx < 0 || xx >= bw) continue;
-        const int r = row[xx];
-        if (r < 0 || (num_ids > 0 && ids[num_ids - 1] == r)) continue;
-        if (std::find(ids.begin(), ids.begin() + num_ids, r) == ids.begin() + num_ids) {
-          ids[num_ids++] = r;
-        }
-      }
+  for (size_t i = 0; i < order.size(); ++i) {
+    const int x = PackedX(order[i]) - bx + 1;
+    const int y = PackedY(order[i]) - by + 1;
+    const int level = order_level[i];
+    int& mine = region_of[y * pw + x];
+    const int* c = &mine;
+    const std::array<int, 8> neighbours{c[-pw - 1], c[-pw], c[-pw + 1], c[-1],
+                                        c[1],       c[pw - 1], c[pw], c[pw + 1]};
+    // Most pixels have no visited neighbour or neighbours of a single region: decided without
+    // branching on each neighbour (as unsigned, -1 is the largest value).
+    int highest = -1;
+    uint32_t lowest = 0xFFFFFFFFu;
+    for (int r : neighbours) {
+      highest = std::max(highest, r);
+      lowest = std::min(lowest, static_cast<uint32_t>(r));
     }
+    if (highest < 0) {
+      mine = static_cast<int>(regions.size());
+      regions.push_back({static_cast<int>(regions.size()), level});
+      continue;
+    }
+    if (static_cast<int>(lowest) == highest) {
+      mine = FindRoot(regions, highest);
+      continue;
+    }
+    // Several regions meet here: the distinct roots, in neighbour order.
     std::array<int, 8> roots;
     int num_roots = 0;
-    for (int k = 0; k < num_ids; ++k) {
-      const int root = FindRoot(regions, ids[k]);
+    for (int r : neighbours) {
+      if (r < 0) continue;
+      const int root = FindRoot(regions, r);
       if (std::find(roots.begin(), roots.begin() + num_roots, root) ==
           roots.begin() + num_roots) {
         roots[num_roots++] = root;
       }
-    }
-    int& mine = region_of[y * bw + x];
-    if (num_roots == 0) {
-      mine = static_cast<int>(regions.size());
-      regions.push_back({static_cast<int>(regions.size()), level});
-      continue;
     }
     int winner = roots[0];
     for (int k = 1; k < num_roots; ++k) {
@@ -196,13 +218,13 @@ void SplitComponent(const cv::Mat& smoothed, const std::vector<int>& component, 
   std::vector<int> root_of(regions.size());
   for (size_t r = 0; r < regions.size(); ++r) root_of[r] = FindRoot(regions, static_cast<int>(r));
   std::vector<int> blob_of_root(regions.size(), -1);
-  for (int index : order) {
-    const int root = root_of[region_of[(index / cols - by) * bw + index % cols - bx]];
+  for (uint32_t p : order) {
+    const int root = root_of[region_of[(PackedY(p) - by + 1) * pw + PackedX(p) - bx + 1]];
     if (blob_of_root[root] < 0) {
       blob_of_root[root] = static_cast<int>(blobs->size());
       blobs->emplace_back();
     }
-    (*blobs)[blob_of_root[root]].pixels.push_back(index);
+    (*blobs)[blob_of_root[root]].pixels.push_back(p);
   }
 }
 
@@ -270,6 +292,13 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
   }
   noise = std::max(0.5, noise);
 
+  // The weighted Jacobian rows sqrt(w_i) J_i and residuals sqrt(w_i) r_i of all samples, in
+  // float: the normal equations are then one symmetric rank-k update (vectorised by Eigen)
+  // instead of a scalar per-sample loop, ~3x faster; float's 1e-7 relative error in J^T W J and
+  // J^T W r moves the converged centre by far less than 1e-3 px.
+  const int num_samples = static_cast<int>(samples.size());
+  Eigen::Matrix<float, Eigen::Dynamic, kParams, Eigen::RowMajor> weighted_j(num_samples, kParams);
+  Eigen::VectorXf weighted_r(num_samples);
   auto evaluate = [&](const Vec& p, Mat* jtj, Vec* jtr, double* weighted_sq) {
     const double u = p[0], v = p[1], s = std::exp(p[2]), a = p[3];
     const double inv_s2 = 1.0 / (s * s);
@@ -283,10 +312,8 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
     const double scale = std::max(3.0 * noise, 0.05 * std::abs(a));
     const double taper = taper_sigmas * s;
     double cost = 0.0, wsq = 0.0;
-    if (jtj) jtj->setZero();
-    if (jtr) jtr->setZero();
-    Vec j;
-    for (const FitSample& q : samples) {
+    for (int i = 0; i < num_samples; ++i) {
+      const FitSample& q = samples[i];
       const double dx = q.x - u, dy = q.y - v;
       const double r2 = dx * dx + dy * dy;
       const double g = std::exp(static_cast<float>(-0.5 * r2 * inv_s2));
@@ -301,49 +328,57 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
         gr = std::exp(static_cast<float>(-0.5 * rr2 * inv_sr2));
         model += ar * gr;
       }
-      if (q.clipped && model >= kFullScale) continue;
+      if (q.clipped && model >= kFullScale) {
+        if (jtj) {
+          weighted_j.row(i).setZero();
+          weighted_r[i] = 0.0f;
+        }
+        continue;
+      }
       const double r = q.value - model;
       // Position weight: below the light (where its reflection lies) the data count less.
-      double w = 1.0;
-      if (taper > 0.0 && dy > 0.0) w = std::exp(-0.5 * (dy / taper) * (dy / taper));
-      const double position_weight = w;
+      double sqrt_position_weight = 1.0;
+      if (taper > 0.0 && dy > 0.0) sqrt_position_weight = std::exp(-0.25 * (dy / taper) * (dy / taper));
+      const double position_weight = sqrt_position_weight * sqrt_position_weight;
+      double sqrt_w = sqrt_position_weight;
       if (r > 0.0) {
         // Geman-McClure: rho = s^2 z^2 / (2 (1 + z^2)), IRLS weight 1 / (1 + z^2)^2.
         const double z2 = (r / scale) * (r / scale);
         const double d = 1.0 / (1.0 + z2);
-        w *= d * d;
+        sqrt_w *= d;
         cost += position_weight * 0.5 * scale * scale * z2 * d;
       } else {
         cost += position_weight * 0.5 * r * r;
       }
-      wsq += w * r * r;
+      wsq += sqrt_w * sqrt_w * r * r;
       if (!jtj) continue;
-      const double ag = a * g * inv_s2;
+      float* j = weighted_j.row(i).data();
+      weighted_r[i] = static_cast<float>(sqrt_w * r);
+      const double ag = sqrt_w * a * g * inv_s2;
       j[0] = ag * dx;
       j[1] = ag * dy;
       j[2] = ag * r2;
-      j[3] = g;
-      j[4] = 1.0;
-      j[5] = qx;
-      j[6] = qy;
-      j[7] = qx * qx;
-      j[8] = qx * qy;
-      j[9] = qy * qy;
+      j[3] = sqrt_w * g;
+      j[4] = sqrt_w;
+      j[5] = sqrt_w * qx;
+      j[6] = sqrt_w * qy;
+      j[7] = sqrt_w * qx * qx;
+      j[8] = sqrt_w * qx * qy;
+      j[9] = sqrt_w * qy * qy;
       if constexpr (kReflection) {
-        const double agr = ar * gr * inv_sr2;
+        const double agr = sqrt_w * ar * gr * inv_sr2;
         j[kR] = agr * dxr;
         j[kR + 1] = agr * dyr;
         j[kR + 2] = agr * rr2;
-        j[kR + 3] = gr;
-      }
-      // Lower triangle only; plain loops beat a general rank update at this size.
-      for (int a_row = 0; a_row < kParams; ++a_row) {
-        const double wj = w * j[a_row];
-        for (int b_col = 0; b_col <= a_row; ++b_col) (*jtj)(a_row, b_col) += wj * j[b_col];
-        (*jtr)[a_row] += wj * r;
+        j[kR + 3] = sqrt_w * gr;
       }
     }
-    if (jtj) *jtj = jtj->template selfadjointView<Eigen::Lower>();
+    if (jtj) {
+      Eigen::Matrix<float, kParams, kParams> h = Eigen::Matrix<float, kParams, kParams>::Zero();
+      h.template selfadjointView<Eigen::Lower>().rankUpdate(weighted_j.transpose());
+      *jtj = h.template cast<double>().template selfadjointView<Eigen::Lower>();
+      *jtr = (weighted_j.transpose() * weighted_r).template cast<double>();
+    }
     if (weighted_sq) *weighted_sq = wsq;
     return cost;
   };
@@ -536,12 +571,115 @@ double CoreRedRatio(const cv::Mat& image, double u, double v, double sigma) {
   return excess[2] / std::max({1.0, excess[0], excess[1]});
 }
 
+// A connected component of the threshold mask: its pixels in raster order, bounding box and
+// brightest (smoothed) pixel, the first in raster order among equals.
+struct Component {
+  std::vector<uint32_t> pixels;  // packed coordinates
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  uint32_t brightest = 0;
+};
+
+// A horizontal run of mask pixels, [x0, x1] on row y, and its union-find parent.
+struct Run {
+  int y, x0, x1, parent;
+};
+
+int FindRun(std::vector<Run>& runs, int r) {
+  while (runs[r].parent != r) {
+    runs[r].parent = runs[runs[r].parent].parent;
+    r = runs[r].parent;
+  }
+  return r;
+}
+
+// 8-connected components of a CV_8U mask (non-zero = set) by union-find on its runs: the mask is
+// scanned once, skipping empty stretches eight bytes at a time, and only the runs (a few hundred
+// on a frame) are labelled, never a full-size label image. cv::connectedComponents writes a
+// CV_32S label image that then has to be read back to gather the pixels: ~0.55 ms on a 640 x 512
+// frame against ~0.1 ms here. Components come in the raster order of their first pixel.
+std::vector<Component> LabelComponents(const cv::Mat& mask, const cv::Mat& smoothed) {
+  const int rows = mask.rows;
+  const int cols = mask.cols;
+  std::vector<Run> runs;
+  size_t previous_begin = 0, previous_end = 0;  // runs of row y - 1
+  for (int y = 0; y < rows; ++y) {
+    const uint8_t* m = mask.ptr<uint8_t>(y);
+    const size_t row_begin = runs.size();
+    int x = 0;
+    while (x < cols) {
+      if (x + 8 <= cols) {
+        uint64_t chunk;
+        std::memcpy(&chunk, m + x, sizeof(chunk));
+        if (chunk == 0) {
+          x += 8;
+          continue;
+        }
+      }
+      if (m[x] == 0) {
+        ++x;
+        continue;
+      }
+      const int x0 = x;
+      while (x < cols && m[x] != 0) ++x;
+      const int self = static_cast<int>(runs.size());
+      runs.push_back({y, x0, x - 1, self});
+    }
+    // Join each new run with the runs of the row above that touch it (8-connected: overlapping
+    // or diagonally adjacent); the root is always the earliest run.
+    if (previous_end > previous_begin && runs[previous_begin].y == y - 1) {
+      size_t j = previous_begin;
+      for (size_t i = row_begin; i < runs.size(); ++i) {
+        while (j < previous_end && runs[j].x1 < runs[i].x0 - 1) ++j;
+        for (size_t k = j; k < previous_end && runs[k].x0 <= runs[i].x1 + 1; ++k) {
+          const int a = FindRun(runs, static_cast<int>(i));
+          const int b = FindRun(runs, static_cast<int>(k));
+          if (a != b) runs[std::max(a, b)].parent = std::min(a, b);
+        }
+      }
+    }
+    if (runs.size() > row_begin) {
+      previous_begin = row_begin;
+      previous_end = runs.size();
+    }
+  }
+
+  std::vector<Component> components;
+  std::vector<int> component_of_root(runs.size(), -1);
+  std::vector<int> best_level;
+  for (size_t i = 0; i < runs.size(); ++i) {
+    const Run& run = runs[i];
+    const int root = FindRun(runs, static_cast<int>(i));
+    int& id = component_of_root[root];
+    if (id < 0) {
+      id = static_cast<int>(components.size());
+      components.emplace_back();
+      components.back().x0 = run.x0;
+      components.back().y0 = run.y;
+      components.back().x1 = run.x1;
+      components.back().y1 = run.y;
+      best_level.push_back(-1);
+    }
+    Component& component = components[id];
+    component.x0 = std::min(component.x0, run.x0);
+    component.x1 = std::max(component.x1, run.x1);
+    component.y1 = run.y;
+    const uint8_t* level = smoothed.ptr<uint8_t>(run.y);
+    for (int x = run.x0; x <= run.x1; ++x) {
+      component.pixels.push_back(Pack(x, run.y));
+      if (level[x] > best_level[id]) {
+        best_level[id] = level[x];
+        component.brightest = Pack(x, run.y);
+      }
+    }
+  }
+  return components;
+}
+
 // Segments one scale of the smoothed luma into blobs: pixels brighter than the coarse background
-// by the threshold, grouped into 8-connected components (cv::connectedComponents; its WithStats
-// variant costs ~2 ms on a 640 x 512 frame in OpenCV 4.6 against ~0.3 ms, so the pixel lists are
-// gathered here), each split at its significant maxima. Fills the blobs' pixels, luma contrast,
-// luma energy and full-resolution bounding box; `scale` is the downsampling factor of
-// `smoothed` and smoothed_noise its noise sigma. Returns the threshold used.
+// by the threshold, grouped into 8-connected components (LabelComponents), each split at its
+// significant maxima. Fills the blobs' pixels, luma contrast, luma energy and full-resolution
+// bounding box; `scale` is the downsampling factor of `smoothed` and smoothed_noise its noise
+// sigma. Returns the threshold used.
 double SegmentScale(const cv::Mat& smoothed, double smoothed_noise, int scale,
                     const LightDetectorOptions& options, int background_window_cells,
                     double min_area, double max_area_fraction, int full_cols, int full_rows,
@@ -552,7 +690,7 @@ double SegmentScale(const cv::Mat& smoothed, double smoothed_noise, int scale,
       std::max(options.min_contrast, options.threshold_noise_sigmas * smoothed_noise);
 
   const CoarseBackground background(smoothed, options.background_grid_cols,
-                                    background_window_cells);
+                                    options.background_close_cells, background_window_cells);
   if (options.threshold == LightThreshold::kOtsu) {
     // Otsu's cut of the background-subtracted image; the noise-based threshold is its floor.
     cv::Mat background8, excess, unused;
@@ -569,76 +707,42 @@ double SegmentScale(const cv::Mat& smoothed, double smoothed_noise, int scale,
   cv::resize(level, level, smoothed.size(), 0, 0, cv::INTER_LINEAR);
   cv::Mat mask;
   cv::compare(smoothed, level, mask, cv::CMP_GT);
-  cv::Mat labels;
-  const int num_labels = cv::connectedComponents(mask, labels, 8, CV_32S);
-  if (num_labels <= 1) return threshold;
+  const std::vector<Component> components = LabelComponents(mask, smoothed);
+  if (components.empty()) return threshold;
 
-  // Pixel lists, bounding boxes and brightest pixel per component, in one pass that skips the
-  // (mostly empty) mask eight bytes at a time.
-  std::vector<std::vector<int>> components(num_labels);
-  std::vector<std::array<int, 4>> boxes(num_labels, {cols, rows, -1, -1});
-  std::vector<int> brightest(num_labels, -1);
-  for (int y = 0; y < rows; ++y) {
-    const uint8_t* m = mask.ptr<uint8_t>(y);
-    const int* l = labels.ptr<int>(y);
-    for (int x = 0; x < cols; ++x) {
-      if (x + 8 <= cols) {
-        uint64_t chunk;
-        std::memcpy(&chunk, m + x, sizeof(chunk));
-        if (chunk == 0) {
-          x += 7;
-          continue;
-        }
-      }
-      if (m[x] == 0) continue;
-      const int label = l[x];
-      const int index = y * cols + x;
-      components[label].push_back(index);
-      std::array<int, 4>& box = boxes[label];
-      box[0] = std::min(box[0], x);
-      box[1] = std::min(box[1], y);
-      box[2] = std::max(box[2], x);
-      box[3] = std::max(box[3], y);
-      if (brightest[label] < 0 || smoothed.data[index] > smoothed.data[brightest[label]]) {
-        brightest[label] = index;
-      }
-    }
-  }
   const size_t max_area = static_cast<size_t>(max_area_fraction * rows * cols);
   const size_t first = blobs->size();
-  for (int label = 1; label < num_labels; ++label) {
-    const std::vector<int>& component = components[label];
-    if (static_cast<double>(component.size()) * scale * scale < min_area ||
-        component.size() > max_area) {
+  for (const Component& component : components) {
+    if (static_cast<double>(component.pixels.size()) * scale * scale < min_area ||
+        component.pixels.size() > max_area) {
       continue;
     }
     // No blob of a component can be brighter than the component's brightest pixel.
-    const int top = brightest[label];
-    if (smoothed.data[top] - background.At(0, top % cols, top / cols) <
-        options.min_peak_contrast) {
+    const int tx = PackedX(component.brightest), ty = PackedY(component.brightest);
+    if (smoothed.ptr<uint8_t>(ty)[tx] - background.At(0, tx, ty) < options.min_peak_contrast) {
       continue;
     }
-    const std::array<int, 4>& box = boxes[label];
-    SplitComponent(smoothed, component, box[0], box[1], box[2] - box[0] + 1,
-                   box[3] - box[1] + 1, options.min_prominence, blobs);
+    SplitComponent(smoothed, component.pixels, component.x0, component.y0,
+                   component.x1 - component.x0 + 1, component.y1 - component.y0 + 1,
+                   options.min_prominence, blobs);
   }
   for (size_t i = first; i < blobs->size(); ++i) {
     Blob& blob = (*blobs)[i];
     blob.scale = scale;
-    const int top = blob.pixels.front();
-    const double bg = background.At(0, top % cols, top / cols);
-    blob.luma_contrast = smoothed.data[top] - bg;
+    const int tx = PackedX(blob.pixels.front()), ty = PackedY(blob.pixels.front());
+    const double bg = background.At(0, tx, ty);
+    blob.luma_contrast = smoothed.ptr<uint8_t>(ty)[tx] - bg;
     int x0 = cols, y0 = rows, x1 = -1, y1 = -1;
-    double energy = 0.0;
-    for (int index : blob.pixels) {
-      const int x = index % cols, y = index / cols;
+    int64_t level_sum = 0;
+    for (uint32_t p : blob.pixels) {
+      const int x = PackedX(p), y = PackedY(p);
       x0 = std::min(x0, x);
       x1 = std::max(x1, x);
       y0 = std::min(y0, y);
       y1 = std::max(y1, y);
-      energy += smoothed.data[index] - bg;
+      level_sum += smoothed.ptr<uint8_t>(y)[x];
     }
-    blob.luma_energy = energy * scale * scale;
+    blob.luma_energy = (static_cast<double>(level_sum) - bg * blob.pixels.size()) * scale * scale;
     blob.area = static_cast<double>(blob.pixels.size()) * scale * scale;
     blob.x0 = x0 * scale;
     blob.y0 = y0 * scale;
@@ -658,7 +762,6 @@ bool MeasureBlob(const cv::Mat& image, const LightDetectorOptions& options, Blob
   const int cols = image.cols;
   const int channels = image.channels();
   const int f = blob->scale;
-  const int small_cols = cols / f;  // width of the blob grid (cv::resize floors)
 
   // Local background: up to ~256 samples on a ring three pixels (times the scale) outside the
   // bounding box.
@@ -697,9 +800,8 @@ bool MeasureBlob(const cv::Mat& image, const LightDetectorOptions& options, Blob
   const double weight = static_cast<double>(stride) * f * f;
   auto for_each_pixel = [&](auto&& visit) {
     for (size_t i = 0; i < blob->pixels.size(); i += stride) {
-      const int index = blob->pixels[i];
-      const int x = std::min(cols - 1, (index % small_cols) * f + f / 2);
-      const int y = std::min(rows - 1, (index / small_cols) * f + f / 2);
+      const int x = std::min(cols - 1, PackedX(blob->pixels[i]) * f + f / 2);
+      const int y = std::min(rows - 1, PackedY(blob->pixels[i]) * f + f / 2);
       visit(x, y, image.ptr<uint8_t>(y) + channels * x);
     }
   };
@@ -797,7 +899,7 @@ LightDetector::LightDetector(const LightDetectorOptions& options)
     : options_(options), dehazer_(options.dehaze_options) {
   const LightDetectorOptions& o = options_;
   if (!(o.prefilter_sigma_px >= 0.0) || o.median_ksize < 0 || o.background_grid_cols < 2 ||
-      o.background_window_cells < 1 || o.coarse_scale < 0 ||
+      o.background_close_cells < 0 || o.background_window_cells < 1 || o.coarse_scale < 0 ||
       o.coarse_background_window_cells < 1 || o.min_area_px < 1 || !(o.max_area_fraction > 0.0) ||
       o.max_fit_pixels < 16 || !(o.min_contrast >= 0.0) || !(o.min_prominence >= 0.0) ||
       !(o.max_fit_shift_sigmas > 0.0) || !(o.reflection_max_ratio > 0.0)) {
@@ -809,6 +911,9 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
   if (bgr8.empty()) throw std::invalid_argument("LightDetector: empty image");
   if (bgr8.depth() != CV_8U || (bgr8.channels() != 1 && bgr8.channels() != 3)) {
     throw std::invalid_argument("LightDetector: image must be 8-bit BGR or gray");
+  }
+  if (bgr8.cols > 0xFFFF || bgr8.rows > 0xFFFF) {
+    throw std::invalid_argument("LightDetector: image larger than 65535 pixels");
   }
   cv::Mat image = options_.dehaze ? dehazer_.Dehaze(bgr8).image : bgr8;
   if (!image.isContinuous()) image = image.clone();
@@ -969,7 +1074,7 @@ std::vector<LightDetection> LightDetector::Detect(const cv::Mat& bgr8) const {
       if (reflection) continue;
     }
     if (!fit_and_check(*blob)) continue;
-    for (int index : blob->pixels) owner.data[index] = 1;
+    for (uint32_t p : blob->pixels) owner.ptr<uint8_t>(PackedY(p))[PackedX(p)] = 1;
   }
   // Lights bigger than the background window (the last metre of the landing) are found on a
   // downsampled image with a wide window; only the big ones are kept from that scale, and only

@@ -1,6 +1,8 @@
 #include "auvdock/vision/paper_baseline_pipeline.h"
 
 #include <algorithm>
+#include <limits>
+#include <string>
 
 #include "auvdock/vision/omnidirectional_matcher.h"
 #include "auvdock/vision/pnp_solver.h"
@@ -57,24 +59,67 @@ std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& ca
   return T_C_D;
 }
 
-void PaperBaselinePipeline::StereoPose(BaselineFrame* frame) {
-  const auto pairs = MatchStereoDetections(frame->left.detections, frame->right.detections, *left_,
-                                           *right_, options_.stereo);
-  // Identities flow from the identified image to its partner.
-  for (const auto& [l, r] : pairs) {
-    int& id_left = frame->left.light_ids[l];
-    int& id_right = frame->right.light_ids[r];
-    if (id_left < 0) id_left = id_right;
-    if (id_right < 0) id_right = id_left;
+void PaperBaselinePipeline::StereoPose(bool left_identified,
+                                       const std::optional<Pose3>& T_I_D_identified,
+                                       BaselineFrame* frame) {
+  CameraObservation& identified = left_identified ? frame->left : frame->right;
+  CameraObservation& partner = left_identified ? frame->right : frame->left;
+  const CameraCalibration& identified_camera = left_identified ? *left_ : *right_;
+  const CameraCalibration& partner_camera = left_identified ? *right_ : *left_;
+  partner.light_ids.assign(partner.detections.size(), -1);
+
+  // The partner image's own identification, by prediction from the identified camera's pose
+  // through the rig's extrinsics. Left-right matching by position and radius alone can pair a
+  // light with its neighbour when several lights share an epipolar line (the T's crossbar seen
+  // nearly parallel to the baseline at long range: a shift by one light keeps the ordering and
+  // gives a plausible, wrong depth); the prediction cannot, since the whole pattern must line up.
+  std::vector<int> predicted_ids(partner.detections.size(), -1);
+  bool partner_predicted = false;
+  if (T_I_D_identified && identified.status == MatchStatus::kOk) {
+    const Pose3 T_P_D =
+        partner_camera.T_B_C.Inverse() * identified_camera.T_B_C * *T_I_D_identified;
+    TrackingMatcherOptions tracking = options_.tracking;
+    tracking.pixel_noise_px = partner_camera.pixel_noise_px;
+    const MatchResult predicted =
+        MatchByPrediction(partner.detections, dock_, partner_camera.intrinsics, T_P_D, tracking);
+    if (predicted.status == MatchStatus::kOk) {
+      partner_predicted = true;
+      for (const LightMatch& m : predicted.matches) predicted_ids[m.detection] = m.light_id;
+    }
   }
+
+  // Stereo pairs (left, right): with the partner identified, the detections of the same light in
+  // both images, kept if they meet on the epipolar line (triangulation residual within the
+  // epipolar gate); otherwise the paper's left-right matching (MatchStereoDetections), the
+  // identities flowing from the identified image to its partner.
+  std::vector<std::pair<int, int>> pairs;
+  if (partner_predicted) {
+    for (std::size_t i = 0; i < identified.light_ids.size(); ++i) {
+      if (identified.light_ids[i] < 0) continue;
+      for (std::size_t p = 0; p < predicted_ids.size(); ++p) {
+        if (predicted_ids[p] != identified.light_ids[i]) continue;
+        pairs.emplace_back(left_identified ? static_cast<int>(i) : static_cast<int>(p),
+                           left_identified ? static_cast<int>(p) : static_cast<int>(i));
+      }
+    }
+  } else {
+    pairs = MatchStereoDetections(frame->left.detections, frame->right.detections, *left_,
+                                  *right_, options_.stereo);
+  }
+  std::vector<std::pair<int, int>> used;
   std::vector<Eigen::Vector3d> p_S, p_D;
   for (const auto& [l, r] : pairs) {
-    const int id = frame->left.light_ids[l];
-    if (id < 0 || id != frame->right.light_ids[r]) continue;
+    const int i = left_identified ? l : r;
+    const int p = left_identified ? r : l;
+    const int id = identified.light_ids[i];
+    if (id < 0) continue;
     const TriangulatedPoint point =
         TriangulateLinear(frame->left.detections[l].uv, frame->right.detections[r].uv, *left_,
                           *right_, left_->pixel_noise_px);
     if (!point.ok) continue;
+    if (partner_predicted && point.reprojection_rms_px > options_.stereo.epipolar_gate_px) continue;
+    partner.light_ids[p] = id;
+    used.emplace_back(l, r);
     p_S.push_back(point.p_S);
     p_D.push_back(dock_.FindLight(id)->p_D);
   }
@@ -84,6 +129,29 @@ void PaperBaselinePipeline::StereoPose(BaselineFrame* frame) {
     frame->reason = "stereo: " + aligned.reason;
     return;
   }
+  // The aligned pose must put every used light back onto its detection in both images: a wrong
+  // identity cannot be aligned rigidly with the others and shows up here. Refuse rather than
+  // report a wrong pose (and withdraw the transferred identities, which the estimator reads).
+  const Pose3 T_L_D = aligned.T_dst_src.Inverse();
+  const Pose3 T_R_D = right_->T_B_C.Inverse() * left_->T_B_C * T_L_D;
+  double worst_px = 0.0;
+  for (std::size_t k = 0; k < used.size(); ++k) {
+    const auto uv_l = left_->intrinsics.Project(T_L_D * p_D[k]);
+    const auto uv_r = right_->intrinsics.Project(T_R_D * p_D[k]);
+    if (!uv_l || !uv_r) {
+      worst_px = std::numeric_limits<double>::infinity();
+      break;
+    }
+    worst_px = std::max({worst_px, (*uv_l - frame->left.detections[used[k].first].uv).norm(),
+                         (*uv_r - frame->right.detections[used[k].second].uv).norm()});
+  }
+  if (!(worst_px <= options_.max_stereo_reprojection_px)) {
+    partner.light_ids.assign(partner.detections.size(), -1);
+    frame->reason = "stereo: the aligned pose reprojects " + std::to_string(worst_px) +
+                    " px from a light (identities inconsistent)";
+    return;
+  }
+  frame->stereo_reprojection_px = worst_px;
   frame->n_stereo_lights = static_cast<int>(p_S.size());
   frame->T_D_B_stereo = aligned.T_dst_src * left_->T_B_C.Inverse();
 }
@@ -114,24 +182,36 @@ void PaperBaselinePipeline::MonoPose(const std::optional<Pose3>& T_C_D_initial,
 
 BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
                                              const cv::Mat& right, const cv::Mat& mono) {
+  auto detect = [&](const CameraCalibration* camera, const cv::Mat& image) {
+    std::optional<std::vector<LightDetection>> detections;
+    if (camera && !image.empty()) detections = detector_.Detect(image);
+    return detections;
+  };
+  return ProcessDetections(t_ns, detect(left_, left), detect(right_, right), detect(mono_, mono));
+}
+
+BaselineFrame PaperBaselinePipeline::ProcessDetections(
+    int64_t t_ns, const std::optional<std::vector<LightDetection>>& left,
+    const std::optional<std::vector<LightDetection>>& right,
+    const std::optional<std::vector<LightDetection>>& mono) {
   BaselineFrame frame;
   frame.t_ns = t_ns;
-  const bool have_stereo = left_ && right_ && !left.empty() && !right.empty();
-  const bool have_mono = mono_ && !mono.empty();
+  const bool have_stereo = left_ && right_ && left && right;
+  const bool have_mono = mono_ && mono;
   if (have_stereo) {
-    frame.left.detections = detector_.Detect(left);
-    frame.right.detections = detector_.Detect(right);
-    Identify(*left_, t_ns, &frame.left);
-    if (frame.left.status != MatchStatus::kOk) {
-      Identify(*right_, t_ns, &frame.right);
+    frame.left.detections = *left;
+    frame.right.detections = *right;
+    std::optional<Pose3> T_C_D = Identify(*left_, t_ns, &frame.left);
+    const bool left_identified = frame.left.status == MatchStatus::kOk;
+    if (!left_identified) {
+      T_C_D = Identify(*right_, t_ns, &frame.right);
     } else {
-      frame.right.light_ids.assign(frame.right.detections.size(), -1);
       frame.right.status = MatchStatus::kOk;
     }
-    StereoPose(&frame);
+    StereoPose(left_identified, T_C_D, &frame);
   }
   if (have_mono) {
-    frame.mono.detections = detector_.Detect(mono);
+    frame.mono.detections = *mono;
     const std::optional<Pose3> T_C_D = Identify(*mono_, t_ns, &frame.mono);
     if (frame.mono.status == MatchStatus::kOk) MonoPose(T_C_D, &frame);
   }

@@ -1,5 +1,8 @@
 #include "tests/testing/dock_views.h"
 
+#include <algorithm>
+#include <utility>
+
 #include <gtest/gtest.h>
 
 #include "auvdock/geometry/so3.h"
@@ -45,6 +48,42 @@ Pose3 RandomView(const DockModel& dock, const PinholeRadtanCamera& camera, doubl
     }
     if (all_in) return T_C_D;
   }
+}
+
+View MakeView(const DockModel& dock, const PinholeRadtanCamera& camera, const Pose3& T_C_D,
+              const std::vector<int>& visible_ids, int num_spurious, double noise_px,
+              std::mt19937_64& rng) {
+  std::normal_distribution<double> noise(0.0, noise_px);
+  std::uniform_real_distribution<double> u(0.0, camera.width() - 1.0);
+  std::uniform_real_distribution<double> v(0.0, camera.height() - 1.0);
+  std::vector<std::pair<LightDetection, int>> items;
+  for (int id : visible_ids) {
+    LightDetection d;
+    d.uv =
+        *camera.Project(T_C_D * dock.FindLight(id)->p_D) + Eigen::Vector2d(noise(rng), noise(rng));
+    d.score = 1.0;
+    items.emplace_back(d, id);
+  }
+  for (int s = 0; s < num_spurious; ++s) {
+    LightDetection d;
+    d.uv = Eigen::Vector2d(u(rng), v(rng));
+    d.score = 0.5;
+    items.emplace_back(d, -1);
+  }
+  std::shuffle(items.begin(), items.end(), rng);
+  View view;
+  view.T_C_D = T_C_D;
+  for (const auto& [detection, id] : items) {
+    view.detections.push_back(detection);
+    view.truth.push_back(id);
+  }
+  return view;
+}
+
+std::vector<int> AllLightIds(const DockModel& dock) {
+  std::vector<int> ids;
+  for (const DockLight& light : dock.lights) ids.push_back(light.id);
+  return ids;
 }
 
 }  // namespace auvdock::test

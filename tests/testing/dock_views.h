@@ -4,10 +4,12 @@
 
 #include <random>
 #include <string>
+#include <vector>
 
 #include "auvdock/camera/pinhole_radtan_camera.h"
 #include "auvdock/geometry/dock_model.h"
 #include "auvdock/geometry/pose3.h"
+#include "auvdock/vision/light_detection.h"
 
 namespace auvdock::test {
 
@@ -21,5 +23,21 @@ DockModel LoadDock(const std::string& name);
 // Returns T_C_D.
 Pose3 RandomView(const DockModel& dock, const PinholeRadtanCamera& camera, double max_tilt_rad,
                  std::mt19937_64& rng);
+
+// What a light detector would report for a view, with the truth.
+struct View {
+  Pose3 T_C_D;
+  std::vector<LightDetection> detections;
+  std::vector<int> truth;  // light id of each detection, -1 for a spurious one
+};
+
+// Detections of the visible lights (score 1) with Gaussian pixel noise of noise_px per axis, plus
+// num_spurious detections at uniformly random pixels (score 0.5), in random order.
+View MakeView(const DockModel& dock, const PinholeRadtanCamera& camera, const Pose3& T_C_D,
+              const std::vector<int>& visible_ids, int num_spurious, double noise_px,
+              std::mt19937_64& rng);
+
+// The ids of all the dock's lights, in the dock file's order.
+std::vector<int> AllLightIds(const DockModel& dock);
 
 }  // namespace auvdock::test

@@ -24,30 +24,11 @@ namespace {
 
 using test::DefaultMonoCamera;
 using test::LoadDock;
+using test::MakeView;
 using test::RandomView;
+using test::View;
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
-
-
-// Detections of every light (noisy, shuffled) and the light id of each.
-std::vector<LightDetection> Detect(const DockModel& dock, const PinholeRadtanCamera& camera,
-                                   const Pose3& T_C_D, double noise_px, std::mt19937_64& rng,
-                                   std::vector<int>* truth) {
-  std::normal_distribution<double> noise(0.0, noise_px);
-  std::vector<int> order(dock.lights.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-  std::shuffle(order.begin(), order.end(), rng);
-  std::vector<LightDetection> detections;
-  truth->clear();
-  for (int i : order) {
-    LightDetection d;
-    d.uv = *camera.Project(T_C_D * dock.lights[i].p_D) + Eigen::Vector2d(noise(rng), noise(rng));
-    d.score = 1.0;
-    detections.push_back(d);
-    truth->push_back(dock.lights[i].id);
-  }
-  return detections;
-}
 
 bool AllCorrect(const MatchResult& result, const std::vector<int>& truth) {
   if (result.status != MatchStatus::kOk || result.matches.size() != truth.size()) return false;
@@ -106,10 +87,9 @@ TEST(MatchOmnidirectional, SymmetricLayoutsAreAmbiguous) {
   int refused = 0;
   const int views = 1000;
   for (int i = 0; i < views; ++i) {
-    std::vector<int> truth;
-    const auto detections = Detect(
-        centreline, camera, RandomView(centreline, camera, 60.0 * kDeg, rng), 0.3, rng, &truth);
-    refused += MatchOmnidirectional(detections, centreline).status != MatchStatus::kOk;
+    const View view = MakeView(centreline, camera, RandomView(centreline, camera, 60.0 * kDeg, rng),
+                               test::AllLightIds(centreline), 0, 0.3, rng);
+    refused += MatchOmnidirectional(view.detections, centreline).status != MatchStatus::kOk;
   }
   std::printf("omnidirectional, centre-line dock: %d of %d views refused\n", refused, views);
   EXPECT_EQ(refused, views);
@@ -140,13 +120,12 @@ TEST(MatchOmnidirectional, SuccessRateByCameraTilt) {
     const int views = 1000;
     double seconds = 0.0;
     for (int i = 0; i < views; ++i) {
-      std::vector<int> truth;
-      const auto detections = Detect(
-          dock, camera, RandomView(dock, camera, max_tilt_deg * kDeg, rng), 0.3, rng, &truth);
+      const View view = MakeView(dock, camera, RandomView(dock, camera, max_tilt_deg * kDeg, rng),
+                                 test::AllLightIds(dock), 0, 0.3, rng);
       const auto start = std::chrono::steady_clock::now();
-      const MatchResult result = MatchOmnidirectional(detections, dock);
+      const MatchResult result = MatchOmnidirectional(view.detections, dock);
       seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (AllCorrect(result, truth)) {
+      if (AllCorrect(result, view.truth)) {
         ++correct;
       } else if (result.status == MatchStatus::kOk) {
         ++wrong;

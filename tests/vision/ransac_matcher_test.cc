@@ -25,54 +25,11 @@ namespace {
 
 using test::DefaultMonoCamera;
 using test::LoadDock;
+using test::MakeView;
 using test::RandomView;
+using test::View;
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
-
-
-struct View {
-  Pose3 T_C_D;
-  std::vector<LightDetection> detections;
-  std::vector<int> truth;  // light id of each detection, -1 for a spurious one
-};
-
-// Detections of the visible lights with Gaussian pixel noise, plus spurious detections at random
-// pixels, in random order.
-View MakeView(const DockModel& dock, const PinholeRadtanCamera& camera, const Pose3& T_C_D,
-              const std::vector<int>& visible_ids, int num_spurious, double noise_px,
-              std::mt19937_64& rng) {
-  std::normal_distribution<double> noise(0.0, noise_px);
-  std::uniform_real_distribution<double> u(0.0, camera.width() - 1.0);
-  std::uniform_real_distribution<double> v(0.0, camera.height() - 1.0);
-  std::vector<std::pair<LightDetection, int>> items;
-  for (int id : visible_ids) {
-    LightDetection d;
-    d.uv =
-        *camera.Project(T_C_D * dock.FindLight(id)->p_D) + Eigen::Vector2d(noise(rng), noise(rng));
-    d.score = 1.0;
-    items.emplace_back(d, id);
-  }
-  for (int s = 0; s < num_spurious; ++s) {
-    LightDetection d;
-    d.uv = Eigen::Vector2d(u(rng), v(rng));
-    d.score = 0.5;
-    items.emplace_back(d, -1);
-  }
-  std::shuffle(items.begin(), items.end(), rng);
-  View view;
-  view.T_C_D = T_C_D;
-  for (const auto& [detection, id] : items) {
-    view.detections.push_back(detection);
-    view.truth.push_back(id);
-  }
-  return view;
-}
-
-std::vector<int> AllIds(const DockModel& dock) {
-  std::vector<int> ids;
-  for (const DockLight& light : dock.lights) ids.push_back(light.id);
-  return ids;
-}
 
 enum class Outcome { kCorrect, kIncomplete, kRefused, kSilentlyWrong };
 
@@ -164,7 +121,7 @@ void RunScenario(const DockModel& dock, const PinholeRadtanCamera& camera, int n
   const RansacMatcherOptions options;
   for (int i = 0; i < num_views; ++i) {
     const Pose3 T_C_D = RandomView(dock, camera, 60.0 * kDeg, rng);
-    std::vector<int> ids = AllIds(dock);
+    std::vector<int> ids = test::AllLightIds(dock);
     std::shuffle(ids.begin(), ids.end(), rng);
     ids.resize(num_visible);
     const View view = MakeView(dock, camera, T_C_D, ids, num_spurious, 0.3, rng);
@@ -185,7 +142,7 @@ TEST(MatchRansac, AllLightsVisibleIsAlwaysCorrect) {
   std::vector<double> position_errors, angle_errors;
   for (int i = 0; i < 2000; ++i) {
     const View view = MakeView(dock, camera, RandomView(dock, camera, 60.0 * kDeg, rng),
-                               AllIds(dock), 0, 0.3, rng);
+                               test::AllLightIds(dock), 0, 0.3, rng);
     const auto start = std::chrono::steady_clock::now();
     const RansacMatchResult result = MatchRansac(view.detections, dock, camera, options, rng);
     tally.seconds += Seconds(start);
@@ -282,7 +239,7 @@ TEST(MatchRansac, CentrelineDockIsNeverLabelled) {
   Tally tally;
   for (int i = 0; i < 1000; ++i) {
     const View view = MakeView(dock, camera, RandomView(dock, camera, 60.0 * kDeg, rng),
-                               AllIds(dock), i % 3, 0.3, rng);
+                               test::AllLightIds(dock), i % 3, 0.3, rng);
     const RansacMatchResult result = MatchRansac(view.detections, dock, camera, options, rng);
     tally.Add(Classify(result, view), result);
   }
@@ -319,7 +276,7 @@ TEST(MatchRansac, VerifiedPoseAndReportedFigures) {
   const PinholeRadtanCamera camera = DefaultMonoCamera();
   std::mt19937_64 rng(5005);
   const Pose3 T_C_D = RandomView(dock, camera, 30.0 * kDeg, rng);
-  const View view = MakeView(dock, camera, T_C_D, AllIds(dock), 1, 0.0, rng);
+  const View view = MakeView(dock, camera, T_C_D, test::AllLightIds(dock), 1, 0.0, rng);
   const RansacMatchResult result = MatchRansac(view.detections, dock, camera, {}, rng);
   ASSERT_EQ(result.status, MatchStatus::kOk) << result.reason;
   EXPECT_EQ(Classify(result, view), Outcome::kCorrect);

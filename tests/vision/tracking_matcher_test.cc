@@ -22,10 +22,11 @@ namespace {
 
 using test::DefaultMonoCamera;
 using test::LoadDock;
+using test::MakeView;
 using test::RandomView;
+using test::View;
 
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
-
 
 // The camera pose moved by exactly `position_m` in a random direction and rotated by exactly
 // `angle_rad` about a random axis (a prediction error of that size).
@@ -38,42 +39,6 @@ Pose3 Perturb(const Pose3& T_C_D, double position_m, double angle_rad, std::mt19
   T_D_C.p += position_m * direction;
   T_D_C.q = (ExpQuaternion(angle_rad * axis) * T_D_C.q).normalized();
   return T_D_C.Inverse();
-}
-
-struct View {
-  std::vector<LightDetection> detections;
-  std::vector<int> truth;  // light id per detection, -1 spurious
-};
-
-View MakeView(const DockModel& dock, const PinholeRadtanCamera& camera, const Pose3& T_C_D,
-              const std::vector<int>& visible_ids, int num_spurious, double noise_px,
-              std::mt19937_64& rng) {
-  std::normal_distribution<double> noise(0.0, noise_px);
-  std::uniform_real_distribution<double> u(0.0, camera.width() - 1.0);
-  std::uniform_real_distribution<double> v(0.0, camera.height() - 1.0);
-  std::vector<std::pair<Eigen::Vector2d, int>> items;
-  for (int id : visible_ids) {
-    items.emplace_back(
-        *camera.Project(T_C_D * dock.FindLight(id)->p_D) + Eigen::Vector2d(noise(rng), noise(rng)),
-        id);
-  }
-  for (int s = 0; s < num_spurious; ++s) items.emplace_back(Eigen::Vector2d(u(rng), v(rng)), -1);
-  std::shuffle(items.begin(), items.end(), rng);
-  View view;
-  for (const auto& [uv, id] : items) {
-    LightDetection d;
-    d.uv = uv;
-    d.score = 1.0;
-    view.detections.push_back(d);
-    view.truth.push_back(id);
-  }
-  return view;
-}
-
-std::vector<int> AllIds(const DockModel& dock) {
-  std::vector<int> ids;
-  for (const DockLight& light : dock.lights) ids.push_back(light.id);
-  return ids;
 }
 
 enum class Outcome { kCorrect, kIncomplete, kRefused, kSilentlyWrong };
@@ -114,7 +79,7 @@ Counts RunViews(const DockModel& dock, const PinholeRadtanCamera& camera, double
   Counts counts;
   for (int i = 0; i < 1000; ++i) {
     const Pose3 T_C_D = RandomView(dock, camera, 60.0 * kDeg, rng);
-    std::vector<int> ids = AllIds(dock);
+    std::vector<int> ids = test::AllLightIds(dock);
     std::shuffle(ids.begin(), ids.end(), rng);
     ids.resize(num_visible);
     const View view = MakeView(dock, camera, T_C_D, ids, num_spurious, 0.3, rng);
@@ -166,7 +131,7 @@ TEST(MatchByPrediction, ExactPredictionLabelsTheCentrelineDock) {
   Counts counts;
   for (int i = 0; i < 200; ++i) {
     const Pose3 T_C_D = RandomView(dock, camera, 30.0 * kDeg, rng);
-    const View view = MakeView(dock, camera, T_C_D, AllIds(dock), 0, 0.3, rng);
+    const View view = MakeView(dock, camera, T_C_D, test::AllLightIds(dock), 0, 0.3, rng);
     counts.Add(Classify(MatchByPrediction(view.detections, dock, camera,
                                           Perturb(T_C_D, 0.01, 0.3 * kDeg, rng), 20.0),
                         view));
@@ -202,7 +167,7 @@ TEST(MatchByPrediction, SpuriousDetectionNextToALightIsAmbiguous) {
   const PinholeRadtanCamera camera = DefaultMonoCamera();
   std::mt19937_64 rng(22);
   const Pose3 T_C_D = RandomView(dock, camera, 20.0 * kDeg, rng);
-  View view = MakeView(dock, camera, T_C_D, AllIds(dock), 0, 0.0, rng);
+  View view = MakeView(dock, camera, T_C_D, test::AllLightIds(dock), 0, 0.0, rng);
   LightDetection near = view.detections[0];
   near.uv += Eigen::Vector2d(0.4, 0.3);
   view.detections.push_back(near);
@@ -221,7 +186,7 @@ TEST(MatchByPrediction, TooFewMatchesFail) {
   EXPECT_EQ(MatchByPrediction(two.detections, dock, camera, T_C_D, 20.0).status,
             MatchStatus::kFailed);
   // All detections far from every prediction.
-  View far = MakeView(dock, camera, T_C_D, AllIds(dock), 0, 0.3, rng);
+  View far = MakeView(dock, camera, T_C_D, test::AllLightIds(dock), 0, 0.3, rng);
   for (LightDetection& d : far.detections) d.uv += Eigen::Vector2d(150.0, 0.0);
   const MatchResult result = MatchByPrediction(far.detections, dock, camera, T_C_D, 20.0);
   EXPECT_EQ(result.status, MatchStatus::kFailed);

@@ -8,10 +8,14 @@
 //  1. Luma (BT.601, cv::cvtColor) smoothed by a small Gaussian (prefilter_sigma_px; seed 004's
 //     median filter is available as median_ksize, but it flattens small far lights and did not
 //     help: recall, precision and RMS unchanged, 1.5 ms slower).
-//  2. Local background: block means on a coarse grid (background_grid_cols cells across) opened
-//     (min then max filter) with a window of background_window_cells cells, so that anything
-//     narrower than the window - a light and its reflection - is not background while the haze
-//     gradient, vignetting, the lamp's hot spot and the deck are.
+//  2. Local background: block means on a coarse grid (background_grid_cols cells across), closed
+//     (max then min filter) with a window of background_close_cells cells, then opened (min then
+//     max filter) with a window of background_window_cells cells, so that anything narrower than
+//     the window - a light and its reflection - is not background while the haze gradient,
+//     vignetting, the lamp's hot spot and the deck are. The closing fills the lights' dark
+//     housings first: without it the opening's minimum sinks into them, the lamp-lit deck around
+//     the lights rises above the threshold and merges with them (~20000 instead of ~2000 pixels
+//     above the threshold on the benchmark frame: slower, and a light's blob then carries deck).
 //  3. Threshold: smoothed luma > background + max(min_contrast, threshold_noise_sigmas x the
 //     noise of the smoothed image), the noise estimated from neighbour differences. A fixed
 //     contrast above the local background, not Otsu: a frame holds lights from 1 to 8 m whose
@@ -19,7 +23,7 @@
 //     rest drops the faint far ones (kOtsu, floored by the same contrast: turbid recall 0.98
 //     instead of 1.0 on the test run); the light pixels are also too few (< 1 %) for a stable
 //     Otsu split.
-//  4. 8-connected components, each split by flooding at its significant maxima (rising at least
+//  4. 8-connected components (union-find on the mask's runs), each split by flooding at its significant maxima (rising at least
 //     min_prominence above the saddle): two lights that touch become two blobs, while the
 //     shoulder of a merged reflection stays with its light.
 //  5. Per blob, the channel to measure in: the unclipped one with the most light, else the one
@@ -58,11 +62,12 @@
 //
 // Measured on the simulator (tests/vision/light_detector_test.cc: default run, every 4th frame,
 // 3 cameras, reflections, 3 particles per frame, noise; lights nearer than 8 m, matched within
-// 2 px): clear water recall 0.9985, precision 0.994, centroid RMS 0.185 px; turbid water recall
-// 1.0, precision 1.0, RMS 0.21 px. Cost (benchmarks/vision_frontend_benchmark.cc, one core,
-// stereo frame with 6 lights): ~4.6 ms at 640 x 512, ~13.5 ms at 1280 x 1024; the Gaussian fits
-// are a third of it (model_reflections = false or coarse_scale = 0 trade accuracy or the last
-// metre for speed).
+// 2 px): clear water recall 1.0, precision 0.997, centroid RMS 0.187 px; turbid water recall
+// 1.0, precision 1.0, RMS 0.198 px. Cost (benchmarks/vision_frontend_benchmark.cc, one core,
+// stereo frame with 6 lights): ~2.6-2.8 ms at 640 x 512, ~6.2-6.9 ms at 1280 x 1024; the Gaussian fits
+// are about 40 % of it (model_reflections = false or coarse_scale = 0 trade accuracy or the last
+// metre for speed). Fewer fit samples cost accuracy (max_fit_pixels 200: turbid RMS 0.27 px),
+// and so does stopping the fits earlier (turbid RMS 0.21 px, one more false detection per water).
 //
 // Units: pixels and 8-bit gray levels. The sizes that stand for a range (coarse_min_sigma_px,
 // max_unclipped_sigma_px and the pixel of sigma in min_contrast_per_sigma) are per 640 pixels of
@@ -93,6 +98,7 @@ struct LightDetectorOptions {
   int median_ksize = 0;             // seed 004's median pre-filter (odd, >= 3); 0 = none
 
   int background_grid_cols = 80;        // coarse background cells across the image
+  int background_close_cells = 5;       // closing window first (fills dark housings); 0 = none
   int background_window_cells = 9;      // opening window, cells (72 px at 640 px width)
   LightThreshold threshold = LightThreshold::kLocalContrast;
   double threshold_noise_sigmas = 6.0;  // contrast threshold in noise sigmas of the smoothed luma
@@ -136,7 +142,7 @@ class LightDetector {
 
   // The lights in an 8-bit BGR (CV_8UC3) or gray (CV_8UC1) image, by descending score. A gray
   // image has no colour: particles are then only rejected when sharper than min_sigma_px.
-  // Throws std::invalid_argument for an empty image or another type.
+  // Throws std::invalid_argument for an empty image, another type, or a side over 65535 px.
   std::vector<LightDetection> Detect(const cv::Mat& bgr8) const;
 
   const LightDetectorOptions& options() const { return options_; }

@@ -39,7 +39,7 @@
 // image must be similar up to rotation and scale), all lights detected, no spurious detections.
 // Strong perspective breaks it. Measured on the default dock and camera (all 6 lights, 0.3 px,
 // 2-8 m, tests/vision/omnidirectional_matcher_test.cc): 100 % correct with the camera's roll and
-// pitch within +-30 deg of straight down, 98.4 % within +-45 deg, 87.7 % (1.6 % silently wrong)
+// pitch within +-30 deg of straight down, 98.7 % within +-45 deg, 84.9 % (2.5 % silently wrong)
 // within +-60 deg. Use MatchRansac (ransac_matcher.h) there.
 //
 // Units: pixels in, normalized (unit-RMS) units for the costs; MatchResult::cost is the best
