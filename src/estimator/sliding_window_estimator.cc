@@ -5,10 +5,10 @@
 #include <stdexcept>
 #include <utility>
 
-#include <ceres/covariance.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include "auvdock/estimator/marginal_covariance.h"
 #include "auvdock/estimator/marginalization.h"
 #include "factors/bias_prior_factor.h"
 #include "factors/imu_preintegration_factor.h"
@@ -229,24 +229,16 @@ EstimatorOutput SlidingWindowEstimator::Output(const State& state) {
   out.seconds_since_vision =
       last_vision_t_ns_ == INT64_MIN ? -1.0 : Seconds(state.t_ns - last_vision_t_ns_);
   if (options_.compute_covariance) {
-    ceres::Covariance::Options cov_options;
-    cov_options.algorithm_type = ceres::SPARSE_QR;
-    cov_options.num_threads = 1;
-    cov_options.apply_loss_function = true;
-    ceres::Covariance covariance(cov_options);
-    const double* pose = state.pose;
-    std::vector<std::pair<const double*, const double*>> blocks = {{pose, pose}};
-    if (covariance.Compute(blocks, problem_.get())) {
-      Eigen::Matrix<double, 6, 6, Eigen::RowMajor> cov;
-      if (covariance.GetCovarianceMatrixInTangentSpace({pose}, cov.data()) && cov.allFinite()) {
-        out.covariance = cov;
-        out.covariance_ok = true;
-      }
-    }
-    if (!out.covariance_ok) {
+    std::string reason;
+    const std::optional<Eigen::MatrixXd> covariance =
+        MarginalCovariance(problem_.get(), state.pose, {}, &reason);
+    if (covariance) {
+      out.covariance = *covariance;
+      out.covariance_ok = true;
+    } else {
       ++stats_.covariance_failures;
-      stats_.log.push_back("covariance at " + std::to_string(state.t_ns) +
-                           " ns: rank-deficient, not reported");
+      stats_.log.push_back("covariance at " + std::to_string(state.t_ns) + " ns: " + reason +
+                           ", not reported");
     }
   }
   return out;

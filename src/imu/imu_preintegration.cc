@@ -64,6 +64,19 @@ Eigen::Matrix3d RightJacobianSO3(const Eigen::Vector3d& phi) {
          (theta - std::sin(theta)) / (theta_sq * theta) * W * W;
 }
 
+Eigen::Matrix3d InverseRightJacobianSO3(const Eigen::Vector3d& phi) {
+  const double theta_sq = phi.squaredNorm();
+  const Eigen::Matrix3d W = Hat(phi);
+  if (theta_sq < 1e-10) {
+    // Series: the [phi]x^2 coefficient is 1/12 + theta^2/720 + O(theta^4).
+    return Eigen::Matrix3d::Identity() + 0.5 * W + (1.0 / 12.0) * W * W;
+  }
+  const double theta = std::sqrt(theta_sq);
+  const double coefficient =
+      1.0 / theta_sq - (1.0 + std::cos(theta)) / (2.0 * theta * std::sin(theta));
+  return Eigen::Matrix3d::Identity() + 0.5 * W + coefficient * W * W;
+}
+
 ImuPreintegration::ImuPreintegration(const ImuNoiseDensities& noise,
                                      const ImuBias& linearization_bias)
     : noise_(noise), linearization_bias_(linearization_bias) {

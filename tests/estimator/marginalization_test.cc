@@ -11,105 +11,15 @@
 
 #include "factors/marginalization_factor.h"
 #include "factors/pose_manifold.h"
+#include "tests/testing/small_pose_graph.h"
 
 namespace auvdock {
 namespace {
 
-// Test residual: pose b relative to pose a, against a measured relative pose (6), unit weights.
-struct RelativePoseCost {
-  RelativePoseCost(const Eigen::Vector3d& p_ab, const Eigen::Quaterniond& q_ab)
-      : p_ab_(p_ab), q_ab_(q_ab) {}
-  template <typename T>
-  bool operator()(const T* a, const T* b, T* r) const {
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> pa(a), pb(b);
-    const Eigen::Map<const Eigen::Quaternion<T>> qa(a + 3), qb(b + 3);
-    Eigen::Map<Eigen::Matrix<T, 3, 1>> rp(r), rq(r + 3);
-    rp = qa.conjugate() * (pb - pa) - p_ab_.cast<T>();
-    rq = QuaternionLog<T>(q_ab_.conjugate().cast<T>() * qa.conjugate() * qb);
-    return true;
-  }
-  Eigen::Vector3d p_ab_;
-  Eigen::Quaterniond q_ab_;
-};
-
-// Test residual: a Euclidean 3-vector v against a pose, r = R^T v - m (3).
-struct BodyVectorCost {
-  explicit BodyVectorCost(const Eigen::Vector3d& m) : m_(m) {}
-  template <typename T>
-  bool operator()(const T* pose, const T* v, T* r) const {
-    const Eigen::Map<const Eigen::Quaternion<T>> q(pose + 3);
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> vv(v);
-    Eigen::Map<Eigen::Matrix<T, 3, 1>> residual(r);
-    residual = q.conjugate() * vv - m_.cast<T>();
-    return true;
-  }
-  Eigen::Vector3d m_;
-};
-
-// Test residual: absolute pose prior (6), scaled.
-struct PosePriorCost {
-  template <typename T>
-  bool operator()(const T* x, T* r) const {
-    for (int i = 0; i < 3; ++i) r[i] = T(3.0) * x[i];
-    const Eigen::Map<const Eigen::Quaternion<T>> q(x + 3);
-    Eigen::Map<Eigen::Matrix<T, 3, 1>>(r + 3) = T(5.0) * QuaternionLog<T>(q);
-    return true;
-  }
-};
-
-Eigen::Quaterniond RandomRotation(std::mt19937_64& rng, double sigma) {
-  std::normal_distribution<double> n(0.0, sigma);
-  return QuaternionExp<double>(Eigen::Vector3d(n(rng), n(rng), n(rng)));
-}
-
-struct SmallGraph {
-  // Three poses (x0 to be marginalized) and two velocity-like vectors.
-  double pose[3][7];
-  double vec[2][3];
-  std::vector<std::unique_ptr<ceres::CostFunction>> costs;  // for the reference
-  struct Term {
-    ceres::CostFunction* cost;
-    std::vector<double*> blocks;
-  };
-  std::vector<Term> terms;
-};
-
-void BuildSmallGraph(SmallGraph* g, ceres::Problem* problem, const PoseManifold* manifold) {
-  std::mt19937_64 rng(3);
-  std::normal_distribution<double> n(0.0, 1.0);
-  for (auto& pose : g->pose) {
-    const Eigen::Quaterniond q = RandomRotation(rng, 0.6);
-    for (int k = 0; k < 3; ++k) pose[k] = n(rng);
-    for (int k = 0; k < 4; ++k) pose[3 + k] = q.coeffs()[k];
-  }
-  for (auto& v : g->vec) {
-    for (double& x : v) x = n(rng);
-  }
-  auto add = [&](ceres::CostFunction* cost, std::vector<double*> blocks) {
-    g->terms.push_back({cost, blocks});
-    problem->AddResidualBlock(cost, nullptr, blocks);
-  };
-  for (int i = 0; i < 2; ++i) {
-    add(new ceres::AutoDiffCostFunction<RelativePoseCost, 6, 7, 7>(new RelativePoseCost(
-            Eigen::Vector3d(n(rng), n(rng), n(rng)), RandomRotation(rng, 0.3))),
-        {g->pose[i], g->pose[i + 1]});
-  }
-  add(new ceres::AutoDiffCostFunction<PosePriorCost, 6, 7>(new PosePriorCost), {g->pose[0]});
-  add(new ceres::AutoDiffCostFunction<BodyVectorCost, 3, 7, 3>(
-          new BodyVectorCost(Eigen::Vector3d(n(rng), n(rng), n(rng)))),
-      {g->pose[0], g->vec[0]});
-  add(new ceres::AutoDiffCostFunction<BodyVectorCost, 3, 7, 3>(
-          new BodyVectorCost(Eigen::Vector3d(n(rng), n(rng), n(rng)))),
-      {g->pose[1], g->vec[1]});
-  for (auto& pose : g->pose) problem->SetManifold(pose, const_cast<PoseManifold*>(manifold));
-}
-
-ceres::Problem::Options NonOwningManifolds() {
-  ceres::Problem::Options options;
-  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  options.enable_fast_removal = true;
-  return options;
-}
+using test::BuildSmallGraph;
+using test::NonOwningManifolds;
+using test::RandomRotation;
+using test::SmallGraph;
 
 // Dense reference: each term's ambient Jacobian from its own Evaluate, times the manifold's
 // PlusJacobian, stacked over [x0 | pose1, vec0] and Schur-complemented with a full inverse.
@@ -119,47 +29,13 @@ TEST(MarginalizationTest, PriorEqualsDenseSchurComplementReference) {
   SmallGraph g;
   BuildSmallGraph(&g, &problem, &manifold);
 
-  // Reference columns: x0 (6) | pose1 (6) | vec0 (3).
-  const std::vector<double*> order = {g.pose[0], g.pose[1], g.vec[0]};
-  auto column_of = [&](double* block) {
-    int col = 0;
-    for (double* b : order) {
-      if (b == block) return col;
-      col += b == g.vec[0] ? 3 : 6;
-    }
-    return -1;
-  };
-  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(15, 15);
-  Eigen::VectorXd b = Eigen::VectorXd::Zero(15);
-  for (const SmallGraph::Term& term : g.terms) {
-    if (std::find(term.blocks.begin(), term.blocks.end(), g.pose[0]) == term.blocks.end()) {
-      continue;
-    }
-    const int m = term.cost->num_residuals();
-    Eigen::VectorXd r(m);
-    std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J_amb;
-    std::vector<double*> jac_ptrs;
-    for (double* block : term.blocks) {
-      J_amb.emplace_back(m, block == g.vec[0] ? 3 : 7);
-    }
-    for (auto& J : J_amb) jac_ptrs.push_back(J.data());
-    std::vector<const double*> params(term.blocks.begin(), term.blocks.end());
-    ASSERT_TRUE(term.cost->Evaluate(params.data(), r.data(), jac_ptrs.data()));
-    Eigen::MatrixXd J_full = Eigen::MatrixXd::Zero(m, 15);
-    for (size_t i = 0; i < term.blocks.size(); ++i) {
-      double* block = term.blocks[i];
-      const int col = column_of(block);
-      if (block == g.vec[0]) {
-        J_full.middleCols(col, 3) = J_amb[i];
-      } else {
-        Eigen::Matrix<double, 7, 6, Eigen::RowMajor> plus;
-        manifold.PlusJacobian(block, plus.data());
-        J_full.middleCols(col, 6) = J_amb[i] * plus;
-      }
-    }
-    H += J_full.transpose() * J_full;
-    b += J_full.transpose() * r;
-  }
+  // Reference columns: x0 (6) | pose1 (6) | vec0 (3), over the terms that touch x0.
+  Eigen::MatrixXd J;
+  Eigen::VectorXd r;
+  test::DenseTangentJacobian(g, {g.pose[0], g.pose[1], g.vec[0]}, manifold, {g.pose[0]}, &J, &r);
+  ASSERT_EQ(J.cols(), 15);
+  const Eigen::MatrixXd H = J.transpose() * J;
+  const Eigen::VectorXd b = J.transpose() * r;
   const Eigen::MatrixXd H_mm = H.topLeftCorner(6, 6);
   const Eigen::MatrixXd H_km = H.bottomLeftCorner(9, 6);
   const Eigen::MatrixXd H_ref = H.bottomRightCorner(9, 9) - H_km * H_mm.inverse() * H_km.transpose();

@@ -361,5 +361,27 @@ TEST(ImuPreintegration, NoiseDensitiesComeFromTheCalibration) {
   EXPECT_EQ(noise.accelerometer_random_walk, 4.0);
 }
 
+// Jr and its inverse: Jr(phi) Jr^-1(phi) = I for small and large angles, and Jr^-1 is the
+// derivative of Log at Exp(phi) along a right perturbation (numerically, central differences).
+TEST(InverseRightJacobianSO3, InvertsTheRightJacobianAndDifferentiatesLog) {
+  std::mt19937_64 rng(31);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (const double angle : {0.0, 1e-7, 1e-3, 0.3, 1.5, 2.8}) {
+    Eigen::Vector3d axis(normal(rng), normal(rng), normal(rng));
+    const Eigen::Vector3d phi = angle * axis.normalized();
+    const Eigen::Matrix3d product = RightJacobianSO3(phi) * InverseRightJacobianSO3(phi);
+    EXPECT_LT((product - Eigen::Matrix3d::Identity()).norm(), 1e-12) << angle;
+    if (angle < 1e-6) continue;
+    const double h = 1e-6;
+    Eigen::Matrix3d numeric;
+    for (int c = 0; c < 3; ++c) {
+      const Eigen::Vector3d d = h * Eigen::Vector3d::Unit(c);
+      numeric.col(c) = (LogSO3(ExpSO3(phi) * ExpSO3(d)) - LogSO3(ExpSO3(phi) * ExpSO3(-d))) /
+                       (2.0 * h);
+    }
+    EXPECT_LT((numeric - InverseRightJacobianSO3(phi)).norm(), 1e-7) << angle;
+  }
+}
+
 }  // namespace
 }  // namespace auvdock

@@ -16,7 +16,8 @@
 // Each new frame: preintegrate the IMU since the previous state, predict the new state, add the
 // factors, solve (Levenberg-Marquardt, iteration and time budget), gate vision residuals whose
 // Mahalanobis distance exceeds the chi-square gate and re-solve without them, then marginalize
-// the oldest state into the prior when the window is full (estimator/marginalization.h).
+// the oldest state into the prior when the window is full (estimator/marginalization.h), and
+// report the newest pose's marginal covariance (estimator/marginal_covariance.h).
 // Without vision the window carries on on the IMU alone; the covariance grows accordingly.
 //
 // Initialisation: at the first frame with a per-frame pose (VisionFrame::T_D_B_initial): that

@@ -140,4 +140,9 @@ class ImuPreintegration {
 //   Jr = I - (1 - cos|phi|)/|phi|^2 [phi]x + (|phi| - sin|phi|)/|phi|^3 [phi]x^2.
 Eigen::Matrix3d RightJacobianSO3(const Eigen::Vector3d& phi);
 
+// Its inverse, Jr^-1(phi) = d dphi / d Log(...) (Forster eq. 9):
+//   Jr^-1 = I + 1/2 [phi]x + (1/|phi|^2 - (1 + cos|phi|)/(2 |phi| sin|phi|)) [phi]x^2,
+// valid for |phi| < pi (the rotation errors of the factors are far from pi).
+Eigen::Matrix3d InverseRightJacobianSO3(const Eigen::Vector3d& phi);
+
 }  // namespace auvdock
