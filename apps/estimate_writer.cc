@@ -4,22 +4,13 @@
 #include <fstream>
 
 #include "auvdock/io/input_error.h"
+#include "auvdock/io/pose_covariance_csv.h"
 #include "auvdock/io/staged_directory.h"
 
 namespace fs = std::filesystem;
 
 namespace auvdock::cli {
 namespace {
-
-std::string CovarianceHeader() {
-  std::string header = "#timestamp [ns]";
-  for (int r = 0; r < 6; ++r) {
-    for (int c = 0; c < 6; ++c) header += ",c" + std::to_string(r) + std::to_string(c);
-  }
-  return header +
-         " (6x6 row-major; tangent [dp_D x y z (m), dtheta_D x y z (rad)]; "
-         "T_D_B = (p + dp, Exp(dtheta) q))";
-}
 
 std::string PrepareDirectory(const std::string& out_dir) {
   RequireAbsentOrEmptyDirectory(out_dir);
@@ -32,7 +23,7 @@ std::string PrepareDirectory(const std::string& out_dir) {
 EstimateWriter::EstimateWriter(const std::string& out_dir)
     : out_dir_(PrepareDirectory(out_dir)),
       trajectory_(std::make_unique<TumWriter>(out_dir + "/trajectory.tum")),
-      covariance_(out_dir + "/covariance.csv", CovarianceHeader()),
+      covariance_(out_dir + "/covariance.csv", PoseCovarianceCsvHeader()),
       decisions_(out_dir + "/decisions.csv", "#timestamp [ns],decision,reason") {}
 
 void EstimateWriter::Write(const EstimatorOutput& output, const GoNoGoDecision& decision) {

@@ -1,5 +1,6 @@
 // auvdock evaluate: accuracy of an estimated trajectory (TUM file) against a dataset's ground
-// truth -- absolute error overall and per visibility stage, and relative pose error.
+// truth -- absolute error overall and per visibility stage, relative pose error, and with
+// --covariance the consistency of the reported covariances (NEES).
 // The metrics are defined in include/auvdock/eval/trajectory_evaluation.h.
 #include <cmath>
 #include <cstdio>
@@ -17,6 +18,7 @@
 #include "auvdock/geometry/so3.h"
 #include "auvdock/io/dataset.h"
 #include "auvdock/io/input_error.h"
+#include "auvdock/io/pose_covariance_csv.h"
 #include "auvdock/io/tum_io.h"
 
 namespace auvdock::cli {
@@ -27,6 +29,7 @@ constexpr double kRadToDeg = 180.0 / M_PI;
 struct EvaluateOptions {
   std::string dataset_dir;
   std::string estimate_path;
+  std::string covariance_path;  // optional: NEES against the truth
   bool json = false;
   std::string align = "none";
   double rpe_delta_s = 1.0;
@@ -51,6 +54,13 @@ nlohmann::ordered_json Vector3Json(const Eigen::Vector3d& v) {
   return nlohmann::ordered_json::array({v.x(), v.y(), v.z()});
 }
 
+// NaN (no covariance in a group) is written as null by nlohmann::json.
+void AddNeesJson(const ErrorStats& stats, nlohmann::ordered_json* j) {
+  (*j)["nees_n"] = stats.nees_n;
+  (*j)["nees_mean"] = stats.nees_mean;
+  (*j)["nees_above_95"] = stats.nees_above_95;
+}
+
 nlohmann::ordered_json ReportJson(const EvaluateOptions& options, const EvaluationReport& report) {
   nlohmann::ordered_json j;
   j["dataset"] = options.dataset_dir;
@@ -63,6 +73,10 @@ nlohmann::ordered_json ReportJson(const EvaluateOptions& options, const Evaluati
   j["pos_max_abs_m"] = Vector3Json(report.overall.pos_max_abs_m);
   j["att_max_abs_rad"] = Vector3Json(report.overall.att_max_abs_rad);
   j["pos_mean_m"] = Vector3Json(report.overall.pos_mean_m);
+  if (!options.covariance_path.empty()) {
+    j["covariance"] = options.covariance_path;
+    AddNeesJson(report.overall, &j);
+  }
   // NaN RMSEs (no pair) are written as null by nlohmann::json.
   j["rpe"] = {{"delta_s", report.rpe.delta_s},
               {"n_pairs", report.rpe.n_pairs},
@@ -83,6 +97,7 @@ nlohmann::ordered_json ReportJson(const EvaluateOptions& options, const Evaluati
                                           {"pos_max_abs_m", Vector3Json(stats.pos_max_abs_m)},
                                           {"att_max_abs_rad", Vector3Json(stats.att_max_abs_rad)},
                                           {"pos_mean_m", Vector3Json(stats.pos_mean_m)}};
+    if (stats.nees_n > 0) AddNeesJson(stats, &stages[VisibilityStageName(stage)]);
   }
   j["stages"] = stages;
   return j;
@@ -128,6 +143,17 @@ void PrintTable(const EvaluateOptions& options, const EvaluationReport& report) 
                 s.att_max_abs_rad.z() * kRadToDeg);
   }
 
+  if (!options.covariance_path.empty()) {
+    std::printf("\n%-20s %7s %9s %9s   (honest: mean 6, 5 %% above %.2f)\n", "NEES (6-DoF pose)",
+                "n", "mean", "above 95%", kNees95);
+    for (const Row& row : rows) {
+      const ErrorStats& s = *row.stats;
+      if (s.nees_n == 0) continue;
+      std::printf("  %-18s %7d %9.2f %8.1f%%\n", row.name, s.nees_n, s.nees_mean,
+                  100.0 * s.nees_above_95);
+    }
+  }
+
   std::printf("\nrelative pose error over %g s: %d pairs\n", report.rpe.delta_s,
               report.rpe.n_pairs);
   if (report.rpe.n_pairs > 0) {
@@ -153,8 +179,13 @@ void RunEvaluate(const EvaluateOptions& options) {
   const Trajectory estimate = ReadTumTrajectory(options.estimate_path);
   if (estimate.empty()) throw InputError(options.estimate_path + ": trajectory has no poses");
 
-  const EvaluationReport report =
-      EvaluateTrajectory(dataset.groundtruth, estimate, dataset.visibility, evaluation);
+  std::vector<StampedPoseCovariance> covariances;
+  if (!options.covariance_path.empty()) {
+    covariances = ReadPoseCovarianceCsv(options.covariance_path);
+    if (covariances.empty()) throw InputError(options.covariance_path + ": no covariance rows");
+  }
+  const EvaluationReport report = EvaluateTrajectory(dataset.groundtruth, estimate,
+                                                     dataset.visibility, evaluation, covariances);
   if (options.json) {
     std::cout << ReportJson(options, report).dump(2) << std::endl;
   } else {
@@ -176,6 +207,10 @@ void AddEvaluateCommand(CLI::App& root) {
                   "Estimated trajectory: TUM file 't tx ty tz qx qy qz qw' (T_D_B, s, m)")
       ->required()
       ->type_name("FILE.tum");
+  sub->add_option("--covariance", options->covariance_path,
+                  "The estimate's pose covariances (covariance.csv of run/smooth): adds the "
+                  "NEES consistency check")
+      ->type_name("FILE.csv");
   sub->add_flag("--json", options->json, "Print one JSON object instead of a table");
   sub->add_option("--align", options->align,
                   "Align the estimate to the truth first: none (default) or se3 (rigid)")

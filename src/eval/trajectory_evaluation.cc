@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <unordered_map>
 
 #include "auvdock/eval/trajectory_alignment.h"
 #include "auvdock/geometry/so3.h"
@@ -24,7 +25,16 @@ struct MatchedPose {
   Pose3 T_est;
   Pose3 T_true;
   VisibilityStage stage = VisibilityStage::kUnknown;
+  const Eigen::Matrix<double, 6, 6>* covariance = nullptr;  // when the estimate has one here
 };
+
+// e^T Sigma^-1 e with e = Minus(T_est, T_true) in the PoseManifold tangent space.
+double PoseNees(const Pose3& T_est, const Pose3& T_true, const Eigen::Matrix<double, 6, 6>& sigma) {
+  Eigen::Matrix<double, 6, 1> e;
+  e.head<3>() = T_est.p - T_true.p;
+  e.tail<3>() = LogQuaternion(T_est.q * T_true.q.conjugate());
+  return e.dot(sigma.ldlt().solve(e));
+}
 
 // Sums for the absolute-error statistics of one group of poses.
 class ErrorAccumulator {
@@ -45,6 +55,12 @@ class ErrorAccumulator {
     }
   }
 
+  void AddNees(double nees) {
+    ++nees_n_;
+    nees_sum_ += nees;
+    if (nees > kNees95) ++nees_above_;
+  }
+
   int n() const { return n_; }
 
   ErrorStats Stats() const {
@@ -56,6 +72,10 @@ class ErrorAccumulator {
     stats.pos_max_abs_m = max_abs_pos_;
     stats.att_max_abs_rad = max_abs_att_;
     stats.pos_mean_m = sum_pos_ / n_;
+    stats.nees_n = nees_n_;
+    stats.nees_mean = nees_n_ > 0 ? nees_sum_ / nees_n_ : std::nan("");
+    stats.nees_above_95 =
+        nees_n_ > 0 ? static_cast<double>(nees_above_) / nees_n_ : std::nan("");
     return stats;
   }
 
@@ -66,6 +86,9 @@ class ErrorAccumulator {
   Eigen::Vector3d sum_pos_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d max_abs_pos_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d max_abs_att_ = Eigen::Vector3d::Zero();
+  int nees_n_ = 0;
+  int nees_above_ = 0;
+  double nees_sum_ = 0.0;
 };
 
 std::string Seconds(int64_t t_ns) {
@@ -208,8 +231,15 @@ bool ParseAlignment(const std::string& text, Alignment* alignment) {
 EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
                                     const Trajectory& estimate,
                                     const std::vector<VisibilityRecord>& visibility,
-                                    const EvaluationOptions& options) {
+                                    const EvaluationOptions& options,
+                                    const std::vector<StampedPoseCovariance>& covariances) {
   ValidateInputs(truth, estimate, options);
+  if (!covariances.empty() && options.alignment != Alignment::kNone) {
+    throw InputError("covariances are about the unaligned estimate: evaluate them without "
+                     "alignment");
+  }
+  std::unordered_map<int64_t, const Eigen::Matrix<double, 6, 6>*> covariance_at;
+  for (const StampedPoseCovariance& c : covariances) covariance_at[c.t_ns] = &c.covariance;
 
   std::vector<VisibilityRecord> sorted_visibility;
   const std::vector<VisibilityRecord>* stages = &visibility;
@@ -238,6 +268,8 @@ EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
     m.t_ns = pose.t_ns;
     m.T_est = pose.T_D_B;
     m.stage = StageAt(*stages, pose.t_ns);
+    const auto covariance = covariance_at.find(pose.t_ns);
+    if (covariance != covariance_at.end()) m.covariance = covariance->second;
     matched.push_back(m);
   }
 
@@ -273,6 +305,11 @@ EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
   for (const MatchedPose& m : matched) {
     overall.Add(m.T_est, m.T_true);
     per_stage[static_cast<int>(m.stage)].Add(m.T_est, m.T_true);
+    if (m.covariance != nullptr) {
+      const double nees = PoseNees(m.T_est, m.T_true, *m.covariance);
+      overall.AddNees(nees);
+      per_stage[static_cast<int>(m.stage)].AddNees(nees);
+    }
   }
   report.overall = overall.Stats();
   for (int s = 0; s < kNumStages; ++s) {

@@ -319,6 +319,47 @@ TEST(EvaluateTrajectoryTest, RejectsUnusableInput) {
               HasSubstr("non-collinear"));
 }
 
+// NEES with a known answer: the estimate is the truth moved by e = Sigma^1/2 z for a fixed
+// unit vector z in the PoseManifold tangent, so every pose's NEES is |z|^2 = 1 exactly; with
+// z scaled by 4 it is 16 (> 12.59, all above the 95 % point). Poses without a covariance are not
+// counted, and an alignment is refused.
+TEST(EvaluateTrajectoryTest, NeesOfAKnownErrorAndItsCounts) {
+  const std::vector<GroundTruthState> truth = Truth();
+  Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Identity();
+  A(0, 1) = 0.3;
+  A(4, 2) = -0.2;
+  const Eigen::Matrix<double, 6, 6> sqrt_sigma = 0.01 * A;  // Sigma = S S^T
+  Eigen::Matrix<double, 6, 1> z;
+  z << 0.5, -0.5, 0.5, 0.1, -0.3, 0.4;
+  z.normalize();
+  for (const double scale : {1.0, 4.0}) {
+    const Eigen::Matrix<double, 6, 1> e = sqrt_sigma * (scale * z);
+    Trajectory estimate = test::TrajectoryFromTruth(truth);
+    std::vector<StampedPoseCovariance> covariances;
+    for (size_t k = 0; k < estimate.size(); ++k) {
+      StampedPose& pose = estimate[k];
+      pose.T_D_B.p += e.head<3>();
+      pose.T_D_B.q = ExpQuaternion(e.tail<3>()) * pose.T_D_B.q;
+      if (k % 2 == 0) covariances.push_back({pose.t_ns, sqrt_sigma * sqrt_sigma.transpose()});
+    }
+    const EvaluationReport report =
+        EvaluateTrajectory(truth, estimate, {}, EvaluationOptions(), covariances);
+    EXPECT_EQ(report.overall.nees_n, static_cast<int>(covariances.size()));
+    EXPECT_NEAR(report.overall.nees_mean, scale * scale, 1e-6);
+    EXPECT_DOUBLE_EQ(report.overall.nees_above_95, scale > 1.0 ? 1.0 : 0.0);
+  }
+  EvaluationOptions aligned;
+  aligned.alignment = Alignment::kSE3;
+  const Trajectory estimate = test::TrajectoryFromTruth(truth);
+  EXPECT_THROW(EvaluateTrajectory(truth, estimate, {}, aligned,
+                                  {{estimate[0].t_ns, Eigen::Matrix<double, 6, 6>::Identity()}}),
+               InputError);
+  // Without covariances the NEES fields say "none".
+  const EvaluationReport plain = EvaluateTrajectory(truth, estimate, {}, EvaluationOptions());
+  EXPECT_EQ(plain.overall.nees_n, 0);
+  EXPECT_TRUE(std::isnan(plain.overall.nees_mean));
+}
+
 TEST(AlignmentNameTest, RoundTrips) {
   for (Alignment a : {Alignment::kNone, Alignment::kSE3}) {
     Alignment parsed = a == Alignment::kNone ? Alignment::kSE3 : Alignment::kNone;

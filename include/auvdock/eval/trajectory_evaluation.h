@@ -31,6 +31,13 @@
 // T_align (trajectory_alignment.h) to all matched positions and replaces every estimate pose by
 // T_align * T_est, which shows the error that remains after removing a rigid frame offset.
 //
+// Consistency (optional, with the estimate's covariances): for each matched pose with a
+// covariance at exactly its timestamp, the normalized estimation error squared
+//   NEES = e^T Sigma^-1 e,   e = (p_est - p_true, Log(q_est q_true^-1))   (PoseManifold tangent)
+// is chi-square with 6 degrees of freedom when Sigma is honest: mean 6, and 5 % of the poses
+// above kNees95 = 12.59. Consecutive poses of one run are correlated, so the mean of one run
+// scatters more than independent samples would; the tests average over seeded runs.
+//
 // Stages: an estimate pose belongs to the stage of the last visibility record at or before its
 // time (kUnknown before the first record or with no records).
 #pragma once
@@ -44,6 +51,7 @@
 #include "auvdock/geometry/pose3.h"
 #include "auvdock/geometry/stamped_pose.h"
 #include "auvdock/io/measurements.h"
+#include "auvdock/io/pose_covariance_csv.h"
 
 namespace auvdock {
 
@@ -67,7 +75,13 @@ struct ErrorStats {
   Eigen::Vector3d pos_max_abs_m = Eigen::Vector3d::Zero();    // x, y, z in D
   Eigen::Vector3d att_max_abs_rad = Eigen::Vector3d::Zero();  // roll, pitch, yaw
   Eigen::Vector3d pos_mean_m = Eigen::Vector3d::Zero();       // signed mean of p_est - p_true
+  int nees_n = 0;               // poses with a covariance
+  double nees_mean = 0.0;       // NaN when nees_n == 0
+  double nees_above_95 = 0.0;   // fraction of NEES > kNees95; NaN when nees_n == 0
 };
+
+// The 95 % point of the chi-square distribution with 6 degrees of freedom.
+inline constexpr double kNees95 = 12.5916;
 
 struct RpeStats {
   int n_pairs = 0;
@@ -89,10 +103,12 @@ struct EvaluationReport {
 // is expected in time order (it is sorted if not). Throws InputError if the truth is empty
 // ("dataset has no ground truth"), if no estimate pose can be matched ("estimate has no pose
 // within the ground-truth time span ..."), if the options are invalid, or if SE(3) alignment
-// is requested on degenerate (collinear) positions.
+// is requested on degenerate (collinear) positions, or if covariances are given together with
+// an alignment (the covariance is about the unaligned estimate).
 EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
                                     const Trajectory& estimate,
                                     const std::vector<VisibilityRecord>& visibility,
-                                    const EvaluationOptions& options);
+                                    const EvaluationOptions& options,
+                                    const std::vector<StampedPoseCovariance>& covariances = {});
 
 }  // namespace auvdock
