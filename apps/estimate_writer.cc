@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "auvdock/io/decisions_csv.h"
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/pose_covariance_csv.h"
 #include "auvdock/io/staged_directory.h"
@@ -24,7 +25,7 @@ EstimateWriter::EstimateWriter(const std::string& out_dir)
     : out_dir_(PrepareDirectory(out_dir)),
       trajectory_(std::make_unique<TumWriter>(out_dir + "/trajectory.tum")),
       covariance_(out_dir + "/covariance.csv", PoseCovarianceCsvHeader()),
-      decisions_(out_dir + "/decisions.csv", "#timestamp [ns],decision,reason") {}
+      decisions_(out_dir + "/decisions.csv", DecisionsCsvHeader()) {}
 
 void EstimateWriter::Write(const EstimatorOutput& output, const GoNoGoDecision& decision) {
   trajectory_->Append({output.t_ns, output.T_D_B});
@@ -36,8 +37,7 @@ void EstimateWriter::Write(const EstimatorOutput& output, const GoNoGoDecision& 
 }
 
 void EstimateWriter::WriteNoEstimate(int64_t t_ns, const GoNoGoDecision& decision) {
-  decisions_.Line(std::to_string(t_ns) + "," + (decision.go ? "GO" : "NO-GO") + "," +
-                  decision.reason);
+  decisions_.Line(DecisionsCsvRow({t_ns, decision.go, decision.reason}));
 }
 
 void EstimateWriter::WriteSummary(const nlohmann::json& summary) const {

@@ -14,9 +14,11 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
+#include "auvdock/estimator/go_no_go.h"
 #include "auvdock/eval/trajectory_evaluation.h"
 #include "auvdock/geometry/so3.h"
 #include "auvdock/io/dataset.h"
+#include "auvdock/io/decisions_csv.h"
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/pose_covariance_csv.h"
 #include "auvdock/io/tum_io.h"
@@ -30,6 +32,8 @@ struct EvaluateOptions {
   std::string dataset_dir;
   std::string estimate_path;
   std::string covariance_path;  // optional: NEES against the truth
+  std::string decisions_path;   // optional: go/no-go audit
+  double allowed_lateral_error_m = GoNoGoOptions().allowed_lateral_error_m;
   bool json = false;
   std::string align = "none";
   double rpe_delta_s = 1.0;
@@ -37,13 +41,13 @@ struct EvaluateOptions {
 };
 
 // CLI11's PositiveNumber prints its range up to DBL_MAX in full; this says what is meant.
-CLI::Validator PositiveSeconds() {
+CLI::Validator Positive(const std::string& unit) {
   return CLI::Validator(
-      [](std::string& text) {
+      [unit](std::string& text) {
         char* end = nullptr;
         const double value = std::strtod(text.c_str(), &end);
         if (text.empty() || *end != '\0' || !std::isfinite(value) || !(value > 0.0)) {
-          return "must be a positive number of seconds (got '" + text + "')";
+          return "must be a positive number of " + unit + " (got '" + text + "')";
         }
         return std::string();
       },
@@ -89,6 +93,17 @@ nlohmann::ordered_json ReportJson(const EvaluateOptions& options, const Evaluati
     for (int c = 0; c < 4; ++c) T.push_back(M(r, c));
   }
   j["alignment_T"] = T;
+  if (!options.decisions_path.empty()) {
+    const DecisionAudit& a = report.decisions;
+    j["decisions"] = {{"file", options.decisions_path},
+                      {"allowed_lateral_error_m", options.allowed_lateral_error_m},
+                      {"n_go", a.n_go},
+                      {"n_no_go", a.n_no_go},
+                      {"n_go_unsafe", a.n_go_unsafe},
+                      {"n_go_unmatched", a.n_go_unmatched},
+                      {"max_lateral_error_at_go_m", a.max_lateral_error_at_go_m},
+                      {"max_yaw_error_at_go_rad", a.max_yaw_error_at_go_rad}};
+  }
   nlohmann::ordered_json stages = nlohmann::ordered_json::object();
   for (const auto& [stage, stats] : report.by_stage) {
     stages[VisibilityStageName(stage)] = {{"n", stats.n},
@@ -154,6 +169,17 @@ void PrintTable(const EvaluateOptions& options, const EvaluationReport& report) 
     }
   }
 
+  if (!options.decisions_path.empty()) {
+    const DecisionAudit& a = report.decisions;
+    std::printf("\ngo/no-go audit (allowed lateral error %.3f m)\n", options.allowed_lateral_error_m);
+    std::printf("  %d GO, %d NO-GO; at GO: max true lateral error %.4f m, max yaw error %.3f deg\n",
+                a.n_go, a.n_no_go, a.max_lateral_error_at_go_m,
+                a.max_yaw_error_at_go_rad * kRadToDeg);
+    std::printf("  unsafe GO (true lateral error > allowed): %d", a.n_go_unsafe);
+    if (a.n_go_unmatched > 0) std::printf("; GO without a pose or truth: %d", a.n_go_unmatched);
+    std::printf("\n");
+  }
+
   std::printf("\nrelative pose error over %g s: %d pairs\n", report.rpe.delta_s,
               report.rpe.n_pairs);
   if (report.rpe.n_pairs > 0) {
@@ -179,13 +205,20 @@ void RunEvaluate(const EvaluateOptions& options) {
   const Trajectory estimate = ReadTumTrajectory(options.estimate_path);
   if (estimate.empty()) throw InputError(options.estimate_path + ": trajectory has no poses");
 
-  std::vector<StampedPoseCovariance> covariances;
+  evaluation.allowed_lateral_error_m = options.allowed_lateral_error_m;
+  EstimateReports reports;
   if (!options.covariance_path.empty()) {
-    covariances = ReadPoseCovarianceCsv(options.covariance_path);
-    if (covariances.empty()) throw InputError(options.covariance_path + ": no covariance rows");
+    reports.covariances = ReadPoseCovarianceCsv(options.covariance_path);
+    if (reports.covariances.empty()) {
+      throw InputError(options.covariance_path + ": no covariance rows");
+    }
+  }
+  if (!options.decisions_path.empty()) {
+    reports.decisions = ReadDecisionsCsv(options.decisions_path);
+    if (reports.decisions.empty()) throw InputError(options.decisions_path + ": no decisions");
   }
   const EvaluationReport report = EvaluateTrajectory(dataset.groundtruth, estimate,
-                                                     dataset.visibility, evaluation, covariances);
+                                                     dataset.visibility, evaluation, reports);
   if (options.json) {
     std::cout << ReportJson(options, report).dump(2) << std::endl;
   } else {
@@ -211,6 +244,14 @@ void AddEvaluateCommand(CLI::App& root) {
                   "The estimate's pose covariances (covariance.csv of run/smooth): adds the "
                   "NEES consistency check")
       ->type_name("FILE.csv");
+  sub->add_option("--decisions", options->decisions_path,
+                  "The go/no-go decisions (decisions.csv of run/smooth): adds the audit of GO "
+                  "against the true lateral error")
+      ->type_name("FILE.csv");
+  sub->add_option("--allowed-lateral-error", options->allowed_lateral_error_m,
+                  "Lateral error a GO must stay within, metres (default 0.10, as go/no-go)")
+      ->check(Positive("metres"))
+      ->type_name("METRES");
   sub->add_flag("--json", options->json, "Print one JSON object instead of a table");
   sub->add_option("--align", options->align,
                   "Align the estimate to the truth first: none (default) or se3 (rigid)")
@@ -218,12 +259,12 @@ void AddEvaluateCommand(CLI::App& root) {
       ->type_name("MODE");
   sub->add_option("--rpe-delta", options->rpe_delta_s,
                   "Time step of the relative pose error, seconds (default 1)")
-      ->check(PositiveSeconds())
+      ->check(Positive("seconds"))
       ->type_name("SECONDS");
   sub->add_option("--max-truth-gap", options->max_truth_gap_s,
                   "Skip estimate poses between ground-truth samples further apart than this, "
                   "seconds (default 0.1)")
-      ->check(PositiveSeconds())
+      ->check(Positive("seconds"))
       ->type_name("SECONDS");
   sub->callback([options]() { RunEvaluate(*options); });
 }

@@ -206,6 +206,33 @@ RpeStats ComputeRpe(const std::vector<MatchedPose>& matched, double delta_s) {
   return rpe;
 }
 
+DecisionAudit AuditDecisions(const std::vector<MatchedPose>& matched,
+                            const std::vector<StampedDecision>& decisions, double allowed_m) {
+  std::unordered_map<int64_t, const MatchedPose*> pose_at;
+  for (const MatchedPose& m : matched) pose_at[m.t_ns] = &m;
+  DecisionAudit audit;
+  for (const StampedDecision& d : decisions) {
+    if (!d.go) {
+      ++audit.n_no_go;
+      continue;
+    }
+    ++audit.n_go;
+    const auto it = pose_at.find(d.t_ns);
+    if (it == pose_at.end()) {
+      ++audit.n_go_unmatched;
+      continue;
+    }
+    const MatchedPose& m = *it->second;
+    const double lateral = (m.T_est.p - m.T_true.p).head<2>().norm();
+    const double yaw = std::abs(WrapAngle(RollPitchYawFromQuaternion(m.T_est.q).z() -
+                                          RollPitchYawFromQuaternion(m.T_true.q).z()));
+    audit.max_lateral_error_at_go_m = std::max(audit.max_lateral_error_at_go_m, lateral);
+    audit.max_yaw_error_at_go_rad = std::max(audit.max_yaw_error_at_go_rad, yaw);
+    if (lateral > allowed_m) ++audit.n_go_unsafe;
+  }
+  return audit;
+}
+
 }  // namespace
 
 const char* AlignmentName(Alignment alignment) {
@@ -232,14 +259,19 @@ EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
                                     const Trajectory& estimate,
                                     const std::vector<VisibilityRecord>& visibility,
                                     const EvaluationOptions& options,
-                                    const std::vector<StampedPoseCovariance>& covariances) {
+                                    const EstimateReports& reports) {
   ValidateInputs(truth, estimate, options);
-  if (!covariances.empty() && options.alignment != Alignment::kNone) {
-    throw InputError("covariances are about the unaligned estimate: evaluate them without "
-                     "alignment");
+  if ((!reports.covariances.empty() || !reports.decisions.empty()) &&
+      options.alignment != Alignment::kNone) {
+    throw InputError("covariances and decisions are about the unaligned estimate: evaluate them "
+                     "without alignment");
+  }
+  if (!(options.allowed_lateral_error_m > 0.0)) {
+    throw InputError("allowed lateral error must be positive (got " +
+                     Number(options.allowed_lateral_error_m) + " m)");
   }
   std::unordered_map<int64_t, const Eigen::Matrix<double, 6, 6>*> covariance_at;
-  for (const StampedPoseCovariance& c : covariances) covariance_at[c.t_ns] = &c.covariance;
+  for (const StampedPoseCovariance& c : reports.covariances) covariance_at[c.t_ns] = &c.covariance;
 
   std::vector<VisibilityRecord> sorted_visibility;
   const std::vector<VisibilityRecord>* stages = &visibility;
@@ -318,6 +350,7 @@ EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
     }
   }
   report.rpe = ComputeRpe(matched, options.rpe_delta_s);
+  report.decisions = AuditDecisions(matched, reports.decisions, options.allowed_lateral_error_m);
   return report;
 }
 

@@ -343,7 +343,7 @@ TEST(EvaluateTrajectoryTest, NeesOfAKnownErrorAndItsCounts) {
       if (k % 2 == 0) covariances.push_back({pose.t_ns, sqrt_sigma * sqrt_sigma.transpose()});
     }
     const EvaluationReport report =
-        EvaluateTrajectory(truth, estimate, {}, EvaluationOptions(), covariances);
+        EvaluateTrajectory(truth, estimate, {}, EvaluationOptions(), {covariances, {}});
     EXPECT_EQ(report.overall.nees_n, static_cast<int>(covariances.size()));
     EXPECT_NEAR(report.overall.nees_mean, scale * scale, 1e-6);
     EXPECT_DOUBLE_EQ(report.overall.nees_above_95, scale > 1.0 ? 1.0 : 0.0);
@@ -351,13 +351,38 @@ TEST(EvaluateTrajectoryTest, NeesOfAKnownErrorAndItsCounts) {
   EvaluationOptions aligned;
   aligned.alignment = Alignment::kSE3;
   const Trajectory estimate = test::TrajectoryFromTruth(truth);
-  EXPECT_THROW(EvaluateTrajectory(truth, estimate, {}, aligned,
-                                  {{estimate[0].t_ns, Eigen::Matrix<double, 6, 6>::Identity()}}),
-               InputError);
+  EstimateReports one_covariance;
+  one_covariance.covariances = {{estimate[0].t_ns, Eigen::Matrix<double, 6, 6>::Identity()}};
+  EXPECT_THROW(EvaluateTrajectory(truth, estimate, {}, aligned, one_covariance), InputError);
   // Without covariances the NEES fields say "none".
   const EvaluationReport plain = EvaluateTrajectory(truth, estimate, {}, EvaluationOptions());
   EXPECT_EQ(plain.overall.nees_n, 0);
   EXPECT_TRUE(std::isnan(plain.overall.nees_mean));
+}
+
+// The audit with known errors: poses 0..9 are off by 0.06 m in x and 0.08 m in y (0.10 m
+// lateral, at the limit: safe), poses 10..19 by 0.12 m in x (unsafe), the rest exact. GO at
+// every even pose, one GO at a time with no pose, NO-GO elsewhere.
+TEST(EvaluateTrajectoryTest, DecisionAuditCountsUnsafeGo) {
+  const std::vector<GroundTruthState> truth = Truth();
+  Trajectory estimate = test::TrajectoryFromTruth(truth);
+  EstimateReports reports;
+  for (size_t k = 0; k < 40; ++k) {
+    if (k < 10) estimate[k].T_D_B.p += Eigen::Vector3d(0.06, 0.08, 0.5);  // z does not count
+    if (k >= 10 && k < 20) estimate[k].T_D_B.p.x() += 0.12;
+    reports.decisions.push_back({estimate[k].t_ns, k % 2 == 0, "test"});
+  }
+  reports.decisions.push_back({estimate[40].t_ns + 1, true, "a GO between poses"});
+  EvaluationOptions options;
+  options.allowed_lateral_error_m = 0.10 + 1e-9;
+  const EvaluationReport report = EvaluateTrajectory(truth, estimate, {}, options, reports);
+  const DecisionAudit& a = report.decisions;
+  EXPECT_EQ(a.n_go, 21);
+  EXPECT_EQ(a.n_no_go, 20);
+  EXPECT_EQ(a.n_go_unsafe, 5);  // poses 10, 12, 14, 16, 18
+  EXPECT_EQ(a.n_go_unmatched, 1);
+  EXPECT_NEAR(a.max_lateral_error_at_go_m, 0.12, 1e-12);
+  EXPECT_NEAR(a.max_yaw_error_at_go_rad, 0.0, 1e-9);
 }
 
 TEST(AlignmentNameTest, RoundTrips) {

@@ -38,6 +38,12 @@
 // above kNees95 = 12.59. Consecutive poses of one run are correlated, so the mean of one run
 // scatters more than independent samples would; the tests average over seeded runs.
 //
+// Go/no-go audit (optional, with the estimator's decisions): every decision is matched with the
+// estimate pose at its timestamp and the truth there; the lateral error is the horizontal
+// distance |(p_est - p_true)_xy| in D (D's z is down, so x-y is the dock's plane). A GO whose
+// lateral error exceeds options.allowed_lateral_error_m is an unsafe GO -- what the go/no-go
+// must never issue. A GO without an estimate pose or truth at its time is counted apart.
+//
 // Stages: an estimate pose belongs to the stage of the last visibility record at or before its
 // time (kUnknown before the first record or with no records).
 #pragma once
@@ -50,6 +56,7 @@
 
 #include "auvdock/geometry/pose3.h"
 #include "auvdock/geometry/stamped_pose.h"
+#include "auvdock/io/decisions_csv.h"
 #include "auvdock/io/measurements.h"
 #include "auvdock/io/pose_covariance_csv.h"
 
@@ -66,6 +73,7 @@ struct EvaluationOptions {
   Alignment alignment = Alignment::kNone;
   double rpe_delta_s = 1.0;      // must be positive and finite
   double max_truth_gap_s = 0.1;  // must be positive; +infinity never skips for a gap
+  double allowed_lateral_error_m = 0.10;  // for the go/no-go audit (GoNoGoOptions' default)
 };
 
 struct ErrorStats {
@@ -90,6 +98,21 @@ struct RpeStats {
   double rot_rmse_rad = 0.0;  // NaN when n_pairs == 0
 };
 
+struct DecisionAudit {
+  int n_go = 0;
+  int n_no_go = 0;
+  int n_go_unsafe = 0;              // GO with lateral error > allowed_lateral_error_m
+  int n_go_unmatched = 0;           // GO with no estimate pose or no truth at its time
+  double max_lateral_error_at_go_m = 0.0;
+  double max_yaw_error_at_go_rad = 0.0;
+};
+
+// What the estimator reported besides its poses; both optional.
+struct EstimateReports {
+  std::vector<StampedPoseCovariance> covariances;
+  std::vector<StampedDecision> decisions;
+};
+
 struct EvaluationReport {
   ErrorStats overall;
   RpeStats rpe;
@@ -97,18 +120,19 @@ struct EvaluationReport {
   std::vector<std::pair<VisibilityStage, ErrorStats>> by_stage;
   int n_skipped = 0;  // estimate poses outside the truth span or in a truth gap
   Pose3 alignment;    // T_align; identity with Alignment::kNone
+  DecisionAudit decisions;  // all zero without decisions
 };
 
 // `truth` must have strictly increasing times, `estimate` too (else InputError); `visibility`
 // is expected in time order (it is sorted if not). Throws InputError if the truth is empty
 // ("dataset has no ground truth"), if no estimate pose can be matched ("estimate has no pose
 // within the ground-truth time span ..."), if the options are invalid, or if SE(3) alignment
-// is requested on degenerate (collinear) positions, or if covariances are given together with
-// an alignment (the covariance is about the unaligned estimate).
+// is requested on degenerate (collinear) positions, or if covariances or decisions are given
+// together with an alignment (both are about the unaligned estimate).
 EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
                                     const Trajectory& estimate,
                                     const std::vector<VisibilityRecord>& visibility,
                                     const EvaluationOptions& options,
-                                    const std::vector<StampedPoseCovariance>& covariances = {});
+                                    const EstimateReports& reports = {});
 
 }  // namespace auvdock
