@@ -1,12 +1,24 @@
-// Cost of the vision front-end's first two steps on one rendered camera frame: dark-channel
-// dehazing (seed 000's enhancement) and guide-light detection. The frame is the default
-// scenario's stereo-left camera 8 s into the run (all six lights in view at about 5 m, coastal
-// water, reflections, particles and noise on), at the rig's 640 x 512 and at 1280 x 1024.
-// Budget: dehaze + detect + match + pose <= 5 ms per 640 x 512 frame on one core, so detection
-// (without dehazing) should stay near 2 ms. OpenCV runs single-threaded here, as on one core.
+// Cost of the vision front-end on rendered camera frames of the default scenario (coastal water,
+// reflections, particles and noise on), at the rig's 640 x 512 and at 1280 x 1024:
+//  * BM_Dehaze, BM_Detect: dark-channel dehazing (seed 000's enhancement) and guide-light
+//    detection on the stereo-left frame 8 s into the run (all six lights at about 5 m);
+//  * BM_PerFrame: the whole per-frame path of the paper's baseline (PaperBaselinePipeline::Process
+//    with dehazing on): dehaze + detect + match (hypothesise-and-verify, MatchRansac) + pose.
+//    Arguments width, height, camera, dehaze (1: on, as the budget counts; 0: the pipeline's
+//    default, see light_detector.h). Camera 0 = the down-looking mono camera at t = 20 s (six lights,
+//    pose by PnP), 1 = the stereo pair at t = 8 s (six lights in each image; two images dehazed
+//    and detected, the left one matched, the right one labelled by prediction, triangulation and
+//    SVD alignment). Counters: the same steps timed one by one on the same frame (thread CPU ms):
+//    dehaze_ms and detect_ms per image, match_pose_ms for the rest
+//    (PaperBaselinePipeline::ProcessDetections).
+// Budget: dehaze + detect + match + pose <= 5 ms per 640 x 512 frame on one core (image decoding
+// not counted). OpenCV runs single-threaded here, as on one core.
+#include <ctime>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
@@ -16,23 +28,30 @@
 #include "auvdock/sim/underwater_renderer.h"
 #include "auvdock/vision/dark_channel_dehazer.h"
 #include "auvdock/vision/light_detector.h"
+#include "auvdock/vision/paper_baseline_pipeline.h"
 
 namespace auvdock {
 namespace {
 
-// The default scenario's stereo-left frame at t = 8 s, rendered at width x height.
-cv::Mat RenderFrame(int width, int height) {
+Scenario DefaultScenarioAt(int width, int height) {
   Scenario scenario = LoadScenario(std::string(AUVDOCK_SOURCE_DIR) + "/data/scenarios/default.yaml");
   scenario.cameras.width = width;
   scenario.cameras.height = height;
+  return scenario;
+}
+
+// The default scenario's frame of the camera with `role` at t_s, rendered at width x height.
+cv::Mat RenderFrame(int width, int height, CameraRole role = CameraRole::kStereoLeft,
+                    double t_s = 8.0) {
+  const Scenario scenario = DefaultScenarioAt(width, height);
   const Calibration calibration = MakeCalibration(scenario);  // after the resolution change
-  const CameraCalibration* camera = calibration.FindCameraByRole(CameraRole::kStereoLeft);
-  if (camera == nullptr) throw std::runtime_error("no stereo-left camera in the default rig");
+  const CameraCalibration* camera = calibration.FindCameraByRole(role);
+  if (camera == nullptr) throw std::runtime_error("camera role missing from the default rig");
   const UnderwaterRenderer renderer(*camera, scenario.dock,
                                     WaterModel::ForType(scenario.water_type), scenario.render);
   const DockingTrajectory trajectory(scenario.trajectory);
   std::mt19937_64 rng(42);
-  return renderer.Render(trajectory.At(8.0).T_D_B * camera->T_B_C, rng).image;
+  return renderer.Render(trajectory.At(t_s).T_D_B * camera->T_B_C, rng).image;
 }
 
 void BM_Dehaze(benchmark::State& state) {
@@ -61,6 +80,88 @@ void BM_Detect(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * frame.total());
 }
 BENCHMARK(BM_Detect)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
+
+double ThreadCpuSeconds() {
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
+
+// Mean CPU time of this thread (ms; one core, whatever else the machine runs) of `step` over
+// `repetitions` calls.
+template <typename Step>
+double MeanMilliseconds(int repetitions, Step step) {
+  const double start = ThreadCpuSeconds();
+  for (int i = 0; i < repetitions; ++i) step();
+  return 1e3 * (ThreadCpuSeconds() - start) / repetitions;
+}
+
+void BM_PerFrame(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const int width = static_cast<int>(state.range(0));
+  const int height = static_cast<int>(state.range(1));
+  const bool stereo = state.range(2) == 1;
+  const double t_s = stereo ? 8.0 : 20.0;
+  const int64_t t_ns = static_cast<int64_t>(t_s * 1e9);
+  const Scenario scenario = DefaultScenarioAt(width, height);
+  const Calibration calibration = MakeCalibration(scenario);
+  const cv::Mat none;
+  const cv::Mat left = stereo ? RenderFrame(width, height, CameraRole::kStereoLeft, t_s) : none;
+  const cv::Mat right = stereo ? RenderFrame(width, height, CameraRole::kStereoRight, t_s) : none;
+  const cv::Mat mono = stereo ? none : RenderFrame(width, height, CameraRole::kMono, t_s);
+  PaperBaselineOptions options;
+  options.detector.dehaze = state.range(3) == 1;  // the budget counts it; off by default
+  PaperBaselinePipeline pipeline(calibration, scenario.dock, options);
+
+  BaselineFrame frame;
+  for (auto _ : state) {
+    frame = pipeline.Process(t_ns, left, right, mono);
+    benchmark::DoNotOptimize(frame.T_D_B);
+  }
+  const int lights = stereo ? frame.n_stereo_lights : frame.n_mono_lights;
+  if (!(stereo ? frame.T_D_B_stereo : frame.T_D_B_mono)) {
+    state.SkipWithError(("no pose: " + frame.reason).c_str());
+    return;
+  }
+  state.counters["lights"] = lights;
+
+  // The same steps one by one, on one image of the frame (outside the timed loop).
+  const cv::Mat& image = stereo ? left : mono;
+  const DarkChannelDehazer dehazer(options.detector.dehaze_options);
+  const LightDetector detector(options.detector);  // dehazes, then detects
+  constexpr int kRepetitions = 20;
+  const double dehaze_ms = !options.detector.dehaze ? 0.0 : MeanMilliseconds(kRepetitions, [&] {
+    benchmark::DoNotOptimize(dehazer.Dehaze(image).image.data);
+  });
+  const double dehaze_detect_ms = MeanMilliseconds(kRepetitions, [&] {
+    benchmark::DoNotOptimize(detector.Detect(image).data());
+  });
+  std::optional<std::vector<LightDetection>> left_detections, right_detections, mono_detections;
+  if (stereo) {
+    left_detections = detector.Detect(left);
+    right_detections = detector.Detect(right);
+  } else {
+    mono_detections = detector.Detect(mono);
+  }
+  const double match_pose_ms = MeanMilliseconds(kRepetitions, [&] {
+    benchmark::DoNotOptimize(
+        pipeline.ProcessDetections(t_ns, left_detections, right_detections, mono_detections));
+  });
+  state.counters["dehaze_ms"] = dehaze_ms;
+  state.counters["detect_ms"] = dehaze_detect_ms - dehaze_ms;
+  state.counters["match_pose_ms"] = match_pose_ms;
+}
+BENCHMARK(BM_PerFrame)
+    ->ArgNames({"w", "h", "stereo", "dehaze"})
+    ->Args({640, 512, 0, 1})
+    ->Args({640, 512, 1, 1})
+    ->Args({640, 512, 0, 0})
+    ->Args({640, 512, 1, 0})
+    ->Args({1280, 1024, 0, 1})
+    ->Args({1280, 1024, 1, 1})
+    ->Args({1280, 1024, 0, 0})
+    ->Args({1280, 1024, 1, 0})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace auvdock

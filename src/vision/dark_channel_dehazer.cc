@@ -113,10 +113,24 @@ cv::Mat ChannelMinimum(const cv::Mat& image) {
 // Mean colour of the `count` pixels with the largest dark channel. Ties at the cut-off level are
 // taken in raster order, so exactly `count` pixels are averaged and the result is deterministic.
 cv::Vec3d AtmosphericLight(const cv::Mat& image, const cv::Mat& dark, int count) {
-  std::array<int, 256> histogram{};
+  // Four interleaved partial histograms: the dark channel is smooth, so neighbours fall into the
+  // same bin and a single histogram serialises on that counter (store-to-load forwarding); this
+  // loop was ~20 % of Dehaze.
+  std::array<std::array<int, 256>, 4> partial{};
   for (int y = 0; y < dark.rows; ++y) {
     const uint8_t* d = dark.ptr<uint8_t>(y);
-    for (int x = 0; x < dark.cols; ++x) ++histogram[d[x]];
+    int x = 0;
+    for (; x + 4 <= dark.cols; x += 4) {
+      ++partial[0][d[x]];
+      ++partial[1][d[x + 1]];
+      ++partial[2][d[x + 2]];
+      ++partial[3][d[x + 3]];
+    }
+    for (; x < dark.cols; ++x) ++partial[0][d[x]];
+  }
+  std::array<int, 256> histogram{};
+  for (int b = 0; b < 256; ++b) {
+    histogram[b] = partial[0][b] + partial[1][b] + partial[2][b] + partial[3][b];
   }
   int level = 255;
   int above = 0;  // pixels with dark > level

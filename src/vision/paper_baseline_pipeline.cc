@@ -25,6 +25,14 @@ PaperBaselinePipeline::PaperBaselinePipeline(const Calibration& calibration,
   mono_ = calibration_.FindCameraByRole(CameraRole::kMono);
 }
 
+std::optional<Pose3> PaperBaselinePipeline::Predict(const CameraCalibration& camera,
+                                                    int64_t t_ns) const {
+  const bool recent = last_T_D_B_ && static_cast<double>(t_ns - last_t_ns_) * 1e-9 <=
+                                         options_.tracking_max_age_s;
+  if (!options_.use_tracking || !recent) return std::nullopt;
+  return (*last_T_D_B_ * camera.T_B_C).Inverse();
+}
+
 std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& camera,
                                                      int64_t t_ns, CameraObservation* obs) {
   obs->light_ids.assign(obs->detections.size(), -1);
@@ -39,12 +47,10 @@ std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& ca
     T_C_D = result.T_C_D;
     match = result;
   }
-  const bool recent = last_T_D_B_ && static_cast<double>(t_ns - last_t_ns_) * 1e-9 <=
-                                         options_.tracking_max_age_s;
-  if (match.status != MatchStatus::kOk && options_.use_tracking && recent) {
-    const Pose3 predicted_T_C_D = (*last_T_D_B_ * camera.T_B_C).Inverse();
+  const std::optional<Pose3> predicted_T_C_D = Predict(camera, t_ns);
+  if (match.status != MatchStatus::kOk && predicted_T_C_D) {
     const MatchResult tracked = MatchByPrediction(obs->detections, dock_, camera.intrinsics,
-                                                  predicted_T_C_D, options_.tracking);
+                                                  *predicted_T_C_D, options_.tracking);
     if (tracked.status == MatchStatus::kOk) {
       match = tracked;
       T_C_D = predicted_T_C_D;
@@ -156,7 +162,7 @@ void PaperBaselinePipeline::StereoPose(bool left_identified,
   frame->T_D_B_stereo = aligned.T_dst_src * left_->T_B_C.Inverse();
 }
 
-void PaperBaselinePipeline::MonoPose(const std::optional<Pose3>& T_C_D_initial,
+void PaperBaselinePipeline::MonoPose(const std::optional<Pose3>& predicted_T_C_D,
                                      BaselineFrame* frame) {
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector2d> pixels;
@@ -171,7 +177,10 @@ void PaperBaselinePipeline::MonoPose(const std::optional<Pose3>& T_C_D_initial,
   if (static_cast<int>(points.size()) < needed) return;
   PnpOptions pnp;
   pnp.pixel_sigma = mono_->pixel_noise_px;
-  const PnpResult result = SolvePnp(points, pixels, mono_->intrinsics, pnp, T_C_D_initial);
+  // The prediction, not the matcher's pose: of a planar target's two minima that fit the pixels
+  // equally well the matcher keeps the lower cost, which is no evidence; only a pose known
+  // independently of this image can choose (SolvePnp step 2b), else there is no mono pose.
+  const PnpResult result = SolvePnp(points, pixels, mono_->intrinsics, pnp, predicted_T_C_D);
   if (!result.ok) {
     frame->reason = "mono: " + result.reason;
     return;
@@ -212,8 +221,8 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
   }
   if (have_mono) {
     frame.mono.detections = *mono;
-    const std::optional<Pose3> T_C_D = Identify(*mono_, t_ns, &frame.mono);
-    if (frame.mono.status == MatchStatus::kOk) MonoPose(T_C_D, &frame);
+    Identify(*mono_, t_ns, &frame.mono);
+    if (frame.mono.status == MatchStatus::kOk) MonoPose(Predict(*mono_, t_ns), &frame);
   }
 
   const bool stereo = frame.T_D_B_stereo.has_value();

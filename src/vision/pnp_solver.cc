@@ -5,6 +5,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <sstream>
 
 #include <Eigen/Dense>
 
@@ -34,6 +35,7 @@ constexpr int kMaxPointsForP3pStarts = 5;
 constexpr size_t kP3pStartsKept = 3;
 // Marquardt damping at the start, relative to the diagonal of J^T J: the starts are close.
 constexpr double kInitialDamping = 1e-4;
+constexpr double kPi = 3.14159265358979323846;
 
 struct Rigid {
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
@@ -611,25 +613,91 @@ PnpResult SolvePnp(const std::vector<Eigen::Vector3d>& points_D,
   if (starts.empty()) return Fail("no closed-form start (degenerate image points)");
 
   const Problem problem{points_D, pixels_distorted, camera};
-  std::optional<Refined> best;
+  std::vector<Refined> minima;  // converged, every point in front
   bool any_in_front = false;
   for (const Rigid& start : starts) {
     const Refined refined = Refine(problem, start, options);
     if (!refined.in_front) continue;
     any_in_front = true;
-    if (!refined.converged) continue;
-    if (!best.has_value() || refined.cost < best->cost) best = refined;
+    if (refined.converged) minima.push_back(refined);
   }
-  if (!best.has_value()) {
+  if (minima.empty()) {
     return Fail(any_in_front ? "no convergence" : "points behind the camera at the solution");
   }
+  auto by_cost = [](const Refined& a, const Refined& b) { return a.cost < b.cost; };
+  std::stable_sort(minima.begin(), minima.end(), by_cost);
+  // A (nearly) planar model: the flipped twin of the best minimum is always a candidate, whatever
+  // the starts found (see the file comment, step 2b).
+  const bool check_ambiguity = n >= 4 && options.ambiguity_chi2 > 0.0;
+  if (check_ambiguity && spread(2) / spread(0) <= kHomographyMaxThickness) {
+    const Refined twin = Refine(problem, PlanarFlip(minima.front().T, centroid, B.col(2)), options);
+    if (twin.in_front && twin.converged) {
+      minima.push_back(twin);
+      std::stable_sort(minima.begin(), minima.end(), by_cost);
+    }
+  }
+  const Refined& lowest = minima.front();
 
+  // Normal matrix at the lowest minimum: observability, and the metric that tells a distinct
+  // second minimum from the same one reached by another start.
   Eigen::VectorXd r;
   Eigen::MatrixXd J;
-  Evaluate(problem, best->T, &r, &J);
-  const Matrix6d A = J.transpose() * J;
+  Evaluate(problem, lowest.T, &r, &J);
+  Matrix6d A = J.transpose() * J;
+  if (!(A.diagonal().minCoeff() > 0.0)) return Fail("singular normal equations");
+  const double variance = options.pixel_sigma * options.pixel_sigma;
+
+  // Step 2b: a second minimum, distinct beyond the noise (Mahalanobis distance^2 from the lowest
+  // above ambiguity_chi2 in the lowest's covariance) whose squared error exceeds the lowest's by
+  // less than ambiguity_chi2 sigma^2, explains the pixels about as well.
+  const Refined* rival = nullptr;
+  if (check_ambiguity) {
+    for (std::size_t k = 1; k < minima.size() && rival == nullptr; ++k) {
+      const Refined& other = minima[k];
+      if (2.0 * (other.cost - lowest.cost) / variance >= options.ambiguity_chi2) break;
+      Vector6d d;
+      d << LogSO3(other.T.R * lowest.T.R.transpose()), other.T.t - lowest.T.t;
+      if (d.dot(A * d) / variance > options.ambiguity_chi2) rival = &other;
+    }
+  }
+  const Refined* chosen = &lowest;
+  std::vector<Pose3> ambiguous_T_C_D;
+  if (rival != nullptr) {
+    ambiguous_T_C_D = {Pose3(Eigen::Quaterniond(lowest.T.R), lowest.T.t),
+                       Pose3(Eigen::Quaterniond(rival->T.R), rival->T.t)};
+    const double rms_lowest = std::sqrt(2.0 * lowest.cost / static_cast<double>(n));
+    const double rms_rival = std::sqrt(2.0 * rival->cost / static_cast<double>(n));
+    const double apart = RotationAngleBetween(ambiguous_T_C_D[0].q, ambiguous_T_C_D[1].q);
+    std::ostringstream reason;
+    reason.precision(3);
+    reason << "ambiguous: two poses " << apart * 180.0 / kPi
+           << " deg apart fit the pixels about equally well (rms " << rms_lowest << " and "
+           << rms_rival << " px)";
+    if (!initial_T_C_D.has_value()) {
+      PnpResult refused = Fail(reason.str() + " and there is no prediction to choose");
+      refused.ambiguous_T_C_D = ambiguous_T_C_D;
+      return refused;
+    }
+    const double to_lowest = RotationAngleBetween(initial_T_C_D->q, ambiguous_T_C_D[0].q);
+    const double to_rival = RotationAngleBetween(initial_T_C_D->q, ambiguous_T_C_D[1].q);
+    if (to_rival <= options.prediction_angle_ratio * to_lowest) {
+      chosen = rival;
+    } else if (!(to_lowest <= options.prediction_angle_ratio * to_rival)) {
+      reason << " and the prediction, " << to_lowest * 180.0 / kPi << " and "
+             << to_rival * 180.0 / kPi << " deg from them, does not choose";
+      PnpResult refused = Fail(reason.str());
+      refused.ambiguous_T_C_D = ambiguous_T_C_D;
+      return refused;
+    }
+    if (chosen != &lowest) {
+      Evaluate(problem, chosen->T, &r, &J);
+      A = J.transpose() * J;
+      if (!(A.diagonal().minCoeff() > 0.0)) return Fail("singular normal equations");
+    }
+  }
+  const Refined& best = *chosen;
+
   const Vector6d diagonal = A.diagonal();
-  if (!(diagonal.minCoeff() > 0.0)) return Fail("singular normal equations");
   const Vector6d inv_scale = diagonal.cwiseSqrt().cwiseInverse();
   const Matrix6d A_scaled = inv_scale.asDiagonal() * A * inv_scale.asDiagonal();
   const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen_A(A_scaled);
@@ -640,18 +708,18 @@ PnpResult SolvePnp(const std::vector<Eigen::Vector3d>& points_D,
   const Matrix6d A_scaled_inverse = eigen_A.eigenvectors() *
                                     eigen_A.eigenvalues().cwiseInverse().asDiagonal() *
                                     eigen_A.eigenvectors().transpose();
-  const double variance = options.pixel_sigma * options.pixel_sigma;
 
   PnpResult result;
   result.ok = true;
-  result.T_C_D = Pose3(Eigen::Quaterniond(best->T.R), best->T.t);
+  result.T_C_D = Pose3(Eigen::Quaterniond(best.T.R), best.T.t);
+  result.ambiguous_T_C_D = ambiguous_T_C_D;
   result.covariance_local =
       variance * inv_scale.asDiagonal() * A_scaled_inverse * inv_scale.asDiagonal();
   Matrix6d G = Matrix6d::Identity();
   G.topLeftCorner<3, 3>() = LeftJacobianInverse(LogQuaternion(result.T_C_D.q));
   result.covariance = G * result.covariance_local * G.transpose();
-  result.rms_px = std::sqrt(2.0 * best->cost / static_cast<double>(n));
-  result.iterations = best->iterations;
+  result.rms_px = std::sqrt(2.0 * best.cost / static_cast<double>(n));
+  result.iterations = best.iterations;
   return result;
 }
 

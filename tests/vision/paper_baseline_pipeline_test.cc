@@ -127,5 +127,46 @@ TEST(PaperBaselinePipelineTest, RefusesAStereoPoseThatDoesNotReproject) {
   for (int id : frame.right.light_ids) EXPECT_EQ(id, -1);
 }
 
+
+// The default scenario at t = 27.5 s: the mono camera sees the stem lights 1, 2, 4 and the bar
+// light 3 from 2.5 m (pixels: the light detector's centroids on the rendered frame). The
+// hypothesise-and-verify matcher refuses the set (all lights but one collinear), tracking labels
+// it, and of the two PnP minima that fit these pixels equally well the flipped one (21 deg of
+// roll, 0.9 m across the dock) has the lower cost; it used to be reported. The prediction from
+// the previous frame must choose the true one.
+TEST(PaperBaselinePipelineTest, MonoPoseOfAPlanarTwinIsChosenByThePrediction) {
+  const Scenario scenario = test::DefaultScenario();
+  const Calibration calibration = MakeCalibration(scenario);
+  const DockingTrajectory trajectory(scenario.trajectory);
+  PaperBaselinePipeline pipeline(calibration, scenario.dock);
+  const CameraCalibration& mono = *pipeline.mono_camera();
+
+  // t = 27.4 s: five lights, identified from scratch; the pose seeds the tracking.
+  const Pose3 T_D_B_previous = trajectory.At(27.4).T_D_B;
+  const BaselineFrame previous =
+      pipeline.ProcessDetections(27'400'000'000, std::nullopt, std::nullopt,
+                                 ProjectLights(mono, scenario.dock, T_D_B_previous));
+  ASSERT_TRUE(previous.T_D_B_mono.has_value()) << previous.reason;
+
+  std::vector<LightDetection> detections(4);
+  detections[0].uv = {344.6086647053071, 267.5940199749991};    // light 4
+  detections[1].uv = {222.5568302291267, 268.2067541410845};    // light 3
+  detections[2].uv = {345.2474492103146, 369.34529842722975};   // light 2
+  detections[3].uv = {346.32068341040815, 470.40839314548697};  // light 1
+  for (LightDetection& d : detections) {
+    d.radius_px = 23.0;
+    d.peak = 200.0;
+    d.score = 0.74;
+  }
+  const BaselineFrame frame =
+      pipeline.ProcessDetections(27'500'000'000, std::nullopt, std::nullopt, detections);
+  EXPECT_TRUE(frame.mono.tracked);
+  EXPECT_EQ(frame.mono.light_ids, (std::vector<int>{4, 3, 2, 1}));
+  ASSERT_TRUE(frame.T_D_B_mono.has_value()) << frame.reason;
+  const Pose3 T_D_B = trajectory.At(27.5).T_D_B;
+  EXPECT_LT((frame.T_D_B_mono->p - T_D_B.p).norm(), 0.05);
+  EXPECT_LT(RotationAngleBetween(frame.T_D_B_mono->q, T_D_B.q), 0.02);
+}
+
 }  // namespace
 }  // namespace auvdock

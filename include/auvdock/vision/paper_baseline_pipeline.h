@@ -21,8 +21,14 @@
 //      the depth, ~3 m instead of ~9 m, passes the depth gate); the SVD then aligned the wrong
 //      points into a pose 9-10 m off (default scenario, t = 6.0-6.1 s, with the detector's
 //      radii inflated by the lit deck);
-//   4. mono pose: PnP by Levenberg-Marquardt (SolvePnp, eq. 10) from the matcher's pose:
-//      T_C_D, then T_D_B = T_C_D^-1 T_B_C^-1;
+//   4. mono pose: PnP by Levenberg-Marquardt (SolvePnp, eq. 10): T_C_D, then
+//      T_D_B = T_C_D^-1 T_B_C^-1. When two poses fit the lights about equally well (a planar
+//      target's two-fold ambiguity, SolvePnp step 2b) the prediction from the previous reported
+//      pose chooses, if recent and clearly nearer one of them; otherwise there is no mono pose
+//      and the reason says "ambiguous". Why: at t = 27.5 s of the default scenario the mono
+//      camera sees the stem (lights 1, 2, 4, collinear) and light 3 from 2.5 m; the flipped
+//      minimum (21 deg of roll, 0.9 m across the dock away) fitted 0.1 px^2 better than the true
+//      one and was reported. The matcher's own pose is no tie-breaker: it kept the lower cost;
 //   4b. tracking (optional, on by default): when the hypothesise-and-verify matcher cannot
 //      identify an image (too few lights in general position, ambiguity) and the previous
 //      frame's pose is recent, the dock is projected with that pose and the detections are
@@ -126,7 +132,11 @@ class PaperBaselinePipeline {
   // T_I_D_identified: the pose of the identified stereo camera (left if left_identified).
   void StereoPose(bool left_identified, const std::optional<Pose3>& T_I_D_identified,
                   BaselineFrame* frame);
-  void MonoPose(const std::optional<Pose3>& T_C_D_initial, BaselineFrame* frame);
+  // predicted_T_C_D: from the previous reported pose (Predict), the PnP's start and tie-breaker.
+  void MonoPose(const std::optional<Pose3>& predicted_T_C_D, BaselineFrame* frame);
+  // T_C_D of `camera` predicted from the previous reported pose, if tracking is on and that pose
+  // is at most tracking_max_age_s old.
+  std::optional<Pose3> Predict(const CameraCalibration& camera, int64_t t_ns) const;
 
   Calibration calibration_;
   DockModel dock_;

@@ -18,7 +18,7 @@
 //      - at most 5 points (where both of the above are fragile, e.g. 4 of 5 dock lights on one
 //        line leave the homography undetermined): P3P on every triple (Grunert's law-of-cosines
 //        system reduced to a quartic), the 3 poses that best reproject all points;
-//      - initial_T_C_D, when given.
+//      - initial_T_C_D, when given (see also step 2b).
 //      Points with a thickness between the planar and non-planar regimes get both kinds.
 //   2. Levenberg-Marquardt (Marquardt's diagonal damping, Nielsen's damping update) on the
 //      pixel residuals through the full distortion model, with the analytic Jacobian
@@ -26,9 +26,24 @@
 //      over a left perturbation R <- Exp(dtheta) R, t <- t + dt, so that
 //        d x_C/d dtheta = -[R X]x,   d x_C/d dt = I.
 //      Every start is refined; the lowest final cost among the converged starts with every
-//      point in front of the camera wins. (OpenCV's SOLVEPNP_ITERATIVE refines one start and
-//      can stop in a worse local minimum with few or noisy points; where both reach the same
-//      minimum they agree to its tolerance, ~1e-7.)
+//      point in front of the camera wins -- unless step 2b finds a rival. (OpenCV's
+//      SOLVEPNP_ITERATIVE refines one start and can stop in a worse local minimum with few or
+//      noisy points; where both reach the same minimum they agree to its tolerance, ~1e-7.)
+//  2b. Two-fold ambiguity (4 or more points): a planar target has a second local minimum, the
+//      plane tilted the other way about the line of sight, which the pixel noise can make as
+//      good as the true one or better -- e.g. the T dock's stem (3 collinear lights) plus one
+//      bar light seen from 2.5 m nearly straight down: the two minima are 21 deg apart in roll
+//      and 0.9 m apart across the dock, their squared errors differ by 0.1 px^2 (default
+//      scenario, t = 27.5 s). So the flipped twin of the best minimum is refined as well, and a
+//      converged minimum that is distinct (Mahalanobis distance^2 from the best, in the best's
+//      covariance, above ambiguity_chi2) and fits about as well (squared error above the best's
+//      by less than ambiguity_chi2 sigma^2, a likelihood ratio below e^(chi2/2)) makes the pose
+//      ambiguous. Then initial_T_C_D, if given, chooses: the minimum whose rotation is nearer
+//      to it wins if it is at most prediction_angle_ratio times as far as the other (the two
+//      differ mainly by the flip rotation, tens of degrees, against a prediction error of about
+//      a degree); otherwise -- or without initial_T_C_D -- ok = false, "ambiguous: ...", with
+//      both minima in ambiguous_T_C_D. So initial_T_C_D must be a pose known independently of
+//      these pixels (a tracked prediction), never one picked among their minima by cost.
 //   3. Covariance by first-order propagation at the solution, Sigma = pixel_sigma^2 I:
 //        P_local = (J^T Sigma^-1 J)^-1                 over (dtheta, dt)
 //        P       = G P_local G^T,  G = blockdiag(Jl(rvec)^-1, I)
@@ -37,7 +52,8 @@
 //      parameters (rvec, tvec); P_local is also returned for the estimator's manifold.
 //
 // With exactly 3 points P3P has up to 4 exact solutions, so without initial_T_C_D the answer
-// is "ambiguous" (ok = false); with it, the solver refines from it (6 residuals, 6 unknowns).
+// is "ambiguous" (ok = false); with it, the solver refines from it (6 residuals, 6 unknowns;
+// step 2b does not apply).
 //
 // Frames and units: X in the model (dock) frame D, metres; pixels in the raw image; the
 // rotation vector in radians, translation in metres.
@@ -63,6 +79,12 @@ struct PnpOptions {
   double gradient_tolerance = 1e-10;
   double step_tolerance = 1e-12;
   double function_tolerance = 1e-14;
+  // Step 2b: a distinct minimum fitting within this chi-square (x sigma^2) of the best makes the
+  // pose ambiguous; <= 0 turns the check off (the lowest cost then always wins).
+  double ambiguity_chi2 = 9.0;
+  // Step 2b: initial_T_C_D chooses a minimum only if it is at most this fraction of its rotation
+  // distance to the other one away from it.
+  double prediction_angle_ratio = 0.5;
 };
 
 struct PnpResult {
@@ -76,11 +98,15 @@ struct PnpResult {
   Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
   double rms_px = 0;   // sqrt(mean_i |pi(x_Ci) - u_i|^2), pixels
   int iterations = 0;  // Levenberg-Marquardt iterations of the winning start
+  // Step 2b: when two minima fit the pixels about equally well, both (lowest cost first) --
+  // whether initial_T_C_D chose one (ok, T_C_D is one of them) or not (ok = false).
+  std::vector<Pose3> ambiguous_T_C_D;
 };
 
 // points_D[i] projects to pixels_distorted[i]. See the file comment for the method.
 // ok = false with a reason for: fewer than 3 correspondences, size mismatch, NaN/Inf input,
-// collinear model points, 3 points without initial_T_C_D (ambiguous), points behind the camera
+// collinear model points, 3 points without initial_T_C_D (ambiguous), two minima that fit
+// equally well and that initial_T_C_D does not tell apart (ambiguous), points behind the camera
 // at the solution, singular normal equations (an unobservable pose), no convergence, and a
 // non-positive pixel_sigma.
 PnpResult SolvePnp(const std::vector<Eigen::Vector3d>& points_D,
