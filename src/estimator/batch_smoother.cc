@@ -83,6 +83,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   }
   VisionRig rig;
   rig.stereo_left = calibration.FindCameraByRole(CameraRole::kStereoLeft);
+  rig.stereo_right = calibration.FindCameraByRole(CameraRole::kStereoRight);
   rig.mono = calibration.FindCameraByRole(CameraRole::kMono);
   rig.dock = &dock;
   std::map<int64_t, const VisionFrame*> frame_at;

@@ -73,6 +73,7 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
     throw std::invalid_argument("SlidingWindowEstimator: the calibration has no IMU");
   }
   rig_.stereo_left = calibration_.FindCameraByRole(CameraRole::kStereoLeft);
+  rig_.stereo_right = calibration_.FindCameraByRole(CameraRole::kStereoRight);
   rig_.mono = calibration_.FindCameraByRole(CameraRole::kMono);
   rig_.dock = &dock_;
   Reset("");

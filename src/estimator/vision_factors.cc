@@ -1,10 +1,13 @@
 #include "auvdock/estimator/vision_factors.h"
 
 #include <cmath>
+#include <optional>
 
 #include <ceres/loss_function.h>
 
 #include "factors/mono_reprojection_factor.h"
+#include "auvdock/geometry/pose3.h"
+#include "auvdock/vision/stereo_triangulation.h"
 #include "factors/stereo_point_factor.h"
 
 namespace auvdock {
@@ -14,6 +17,27 @@ ceres::LossFunction* WeightedHuber(double huber_sigmas, double weight) {
   ceres::LossFunction* huber = new ceres::HuberLoss(huber_sigmas);
   if (weight == 1.0) return huber;
   return new ceres::ScaledLoss(huber, weight, ceres::TAKE_OWNERSHIP);
+}
+
+// The triangulation covariance of a light at its position predicted from the pose block's
+// value: projected into both cameras (noise-free pixels) and propagated as the front-end does.
+std::optional<Eigen::Matrix3d> PredictedStereoCovariance(const VisionRig& rig, const double* pose,
+                                                         const Eigen::Vector3d& p_D) {
+  const Pose3 T_D_B(Eigen::Map<const Eigen::Quaterniond>(pose + 3).normalized(),
+                    Eigen::Map<const Eigen::Vector3d>(pose));
+  const Eigen::Vector3d p_B = T_D_B.Inverse() * p_D;
+  const auto uv_left = rig.stereo_left->intrinsics.Project(rig.stereo_left->T_B_C.Inverse() * p_B);
+  const auto uv_right =
+      rig.stereo_right->intrinsics.Project(rig.stereo_right->T_B_C.Inverse() * p_B);
+  if (!uv_left || !uv_right) return std::nullopt;
+  const TriangulatedPoint predicted = TriangulateLinear(*uv_left, *uv_right, *rig.stereo_left,
+                                                        *rig.stereo_right,
+                                                        rig.stereo_left->pixel_noise_px);
+  if (!predicted.ok || !predicted.covariance.allFinite() ||
+      Eigen::LLT<Eigen::Matrix3d>(predicted.covariance).info() != Eigen::Success) {
+    return std::nullopt;
+  }
+  return predicted.covariance;
 }
 
 }  // namespace
@@ -50,8 +74,14 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
       ++*n_skipped;
       continue;
     }
+    Eigen::Matrix3d covariance = obs.covariance;
+    if (options.stereo_covariance_at_prediction && rig.stereo_right != nullptr) {
+      if (const auto predicted = PredictedStereoCovariance(rig, pose, light->p_D)) {
+        covariance = *predicted;
+      }
+    }
     const ceres::ResidualBlockId id = problem->AddResidualBlock(
-        StereoPointFactor::Create(obs.p_S, obs.covariance, rig.stereo_left->T_B_C, light->p_D),
+        StereoPointFactor::Create(obs.p_S, covariance, rig.stereo_left->T_B_C, light->p_D),
         WeightedHuber(options.huber_sigmas, weights.stereo), pose);
     added.push_back({id, false});
   }

@@ -1,9 +1,15 @@
-// Consistency of the reported covariances of the sliding window (20 seeded runs of the default
-// docking scenario) and of the batch smoother (10 runs), with synthetic identified lights
-// (0.3 px white noise) and the simulated IMU: the mean NEES of the 6-DoF pose over the frames
-// where a camera system sees at least 3 lights should be near 6 (the dimension). The per-run
-// means are printed; the assertion is a loose band because the frames of a run are strongly
-// correlated, so the chi-square band of independent samples would be far too narrow.
+// Consistency of the reported pose covariances (Bar-Shalom, Li, Kirubarajan, "Estimation with
+// Applications to Tracking and Navigation", 2001, sec. 5.4): N seeded Monte-Carlo runs of the
+// default docking scenario with synthetic identified lights (0.3 px white noise) and the
+// simulated IMU. At each frame time k the average NEES over the runs,
+//   ANEES_k = 1/N sum_runs e_k^T Sigma_k^-1 e_k   (e in the PoseManifold tangent, 6-DoF),
+// is chi-square(6N)/N when the covariances are honest, so it lies in the two-sided 95 % band
+// [chi2_0.025(6N), chi2_0.975(6N)] / N at ~95 % of the times. Asserted: the mean over all times
+// lies in that band, and at least 85 % of the times do for the sliding window, 80 % for the
+// smoother (consecutive times are correlated -- a smoother's errors over longer spans -- so the
+// count scatters more than a binomial would; measured: 92 % and 85 %). Frames: those after the
+// first 2 s (initialisation) where a camera system sees at least 3 lights.
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <vector>
@@ -18,90 +24,103 @@
 namespace auvdock {
 namespace {
 
-TEST(EstimatorConsistencyTest, MeanPoseNeesOverTwentySeedsIsNearSix) {
-  const Scenario scenario = test::DefaultScenario();
-  double sum = 0.0;
-  int count = 0;
-  for (uint64_t seed = 1; seed <= 20; ++seed) {
-    const test::SyntheticRun run = test::MakeSyntheticRun(scenario, seed);
-    SlidingWindowEstimator estimator(run.calibration, run.dock);
-    size_t next_imu = 0;
-    double run_sum = 0.0;
-    int run_count = 0;
-    for (size_t k = 0; k < run.frames.size(); ++k) {
-      const VisionFrame& frame = run.frames[k];
-      while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= frame.t_ns) {
-        estimator.AddImu(run.imu[next_imu++]);
-      }
-      const std::optional<EstimatorOutput> out = estimator.AddVisionFrame(frame);
-      if (!out || !out->covariance_ok || k < 20) continue;  // the first 2 s: initialisation
-      if (frame.mono.size() < 3 && frame.stereo.size() < 3) continue;
-      const Pose3& truth = run.truth[k].T_D_B;
-      Eigen::Matrix<double, 6, 1> e;
-      e.head<3>() = out->T_D_B.p - truth.p;
-      const Eigen::AngleAxisd aa(out->T_D_B.q * truth.q.conjugate());
-      e.tail<3>() = aa.angle() * aa.axis();
-      run_sum += e.dot(out->covariance.ldlt().solve(e));
-      ++run_count;
-    }
-    ASSERT_GT(run_count, 250) << seed;
-    std::printf("seed %2llu: mean NEES %.2f over %d frames\n",
-                static_cast<unsigned long long>(seed), run_sum / run_count, run_count);
-    sum += run_sum;
-    count += run_count;
-  }
-  const double mean = sum / count;
-  std::printf("mean NEES over 20 seeds: %.3f (%d frames)\n", mean, count);
-  EXPECT_GT(mean, 4.5);
-  EXPECT_LT(mean, 8.0);
+// The p-quantile of chi-square with k degrees of freedom (Wilson-Hilferty; for k >= 30 within
+// 0.1 % of the exact value), z the standard normal quantile of p.
+double ChiSquareQuantile(double z, int k) {
+  const double a = 2.0 / (9.0 * k);
+  return k * std::pow(1.0 - a + z * std::sqrt(a), 3);
 }
 
-// The same for the batch smoother's covariance over 10 seeds (every state sees the data on
-// both sides, so its covariance is smaller; with white measurement noise it must still be
-// honest).
-TEST(EstimatorConsistencyTest, MeanSmootherPoseNeesOverTenSeedsIsNearSix) {
+double PoseNees(const EstimatorOutput& out, const Pose3& truth) {
+  Eigen::Matrix<double, 6, 1> e;
+  e.head<3>() = out.T_D_B.p - truth.p;
+  const Eigen::AngleAxisd aa(out.T_D_B.q * truth.q.conjugate());
+  e.tail<3>() = aa.angle() * aa.axis();
+  return e.dot(out.covariance.ldlt().solve(e));
+}
+
+// NEES samples by frame index over the runs.
+class NeesTally {
+ public:
+  void Add(const test::SyntheticRun& run, size_t k, const EstimatorOutput& out) {
+    if (!out.covariance_ok || k < 20) return;
+    if (run.frames[k].mono.size() < 3 && run.frames[k].stereo.size() < 3) return;
+    by_frame_[k].push_back(PoseNees(out, run.truth[k].T_D_B));
+  }
+
+  // Checks the band for `runs` runs and prints the figures.
+  void Check(int runs, double min_share_inside, const char* name) const {
+    const double low = ChiSquareQuantile(-1.959964, 6 * runs) / runs;
+    const double high = ChiSquareQuantile(1.959964, 6 * runs) / runs;
+    double sum = 0.0;
+    int times = 0, inside = 0, samples = 0;
+    for (const auto& [k, values] : by_frame_) {
+      if (static_cast<int>(values.size()) != runs) continue;  // a run had no output here
+      double anees = 0.0;
+      for (double v : values) anees += v;
+      anees /= runs;
+      sum += anees;
+      ++times;
+      inside += anees >= low && anees <= high;
+      samples += runs;
+    }
+    ASSERT_GT(times, 250) << name;
+    const double mean = sum / times;
+    std::printf("%s: %d runs, %d times: mean ANEES %.3f, band [%.2f, %.2f], %.1f %% of the times "
+                "inside\n",
+                name, runs, times, mean, low, high, 100.0 * inside / times);
+    EXPECT_GE(mean, low) << name;
+    EXPECT_LE(mean, high) << name;
+    EXPECT_GE(inside, min_share_inside * times) << name;
+  }
+
+ private:
+  std::map<size_t, std::vector<double>> by_frame_;
+};
+
+// Runs the sliding window over a run, frame by frame; returns the outputs by frame index.
+std::map<size_t, EstimatorOutput> RunWindow(const test::SyntheticRun& run,
+                                            SlidingWindowEstimator* estimator) {
+  std::map<size_t, EstimatorOutput> outputs;
+  size_t next_imu = 0;
+  for (size_t k = 0; k < run.frames.size(); ++k) {
+    while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= run.frames[k].t_ns) {
+      estimator->AddImu(run.imu[next_imu++]);
+    }
+    if (auto out = estimator->AddVisionFrame(run.frames[k])) outputs[k] = *out;
+  }
+  return outputs;
+}
+
+TEST(EstimatorConsistencyTest, SlidingWindowAneesOverTwentyRunsIsInTheChiSquareBand) {
   const Scenario scenario = test::DefaultScenario();
-  double sum = 0.0;
-  int count = 0;
-  for (uint64_t seed = 1; seed <= 10; ++seed) {
+  constexpr int kRuns = 20;
+  NeesTally tally;
+  for (uint64_t seed = 1; seed <= kRuns; ++seed) {
     const test::SyntheticRun run = test::MakeSyntheticRun(scenario, seed);
     SlidingWindowEstimator estimator(run.calibration, run.dock);
-    size_t next_imu = 0;
-    for (const VisionFrame& frame : run.frames) {
-      while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= frame.t_ns) {
-        estimator.AddImu(run.imu[next_imu++]);
-      }
-      estimator.AddVisionFrame(frame);
-    }
+    for (const auto& [k, out] : RunWindow(run, &estimator)) tally.Add(run, k, out);
+  }
+  tally.Check(kRuns, 0.85, "sliding window");
+}
+
+// The batch smoother's covariance (every state sees the data on both sides, so it is smaller)
+// over 20 runs.
+TEST(EstimatorConsistencyTest, SmootherAneesOverTwentyRunsIsInTheChiSquareBand) {
+  const Scenario scenario = test::DefaultScenario();
+  constexpr int kRuns = 20;
+  NeesTally tally;
+  for (uint64_t seed = 1; seed <= kRuns; ++seed) {
+    const test::SyntheticRun run = test::MakeSyntheticRun(scenario, seed);
+    SlidingWindowEstimator estimator(run.calibration, run.dock);
+    RunWindow(run, &estimator);
     const BatchResult batch = SmoothBatch(run.calibration, run.dock, run.frames, run.imu,
                                           estimator.History(), EstimatorOptions());
-    ASSERT_GT(batch.outputs.size(), run.frames.size() - 20) << seed;
-    std::map<int64_t, size_t> frame_at;  // the run may start a few frames late
+    std::map<int64_t, size_t> frame_at;  // a run may start a few frames late
     for (size_t k = 0; k < run.frames.size(); ++k) frame_at[run.frames[k].t_ns] = k;
-    double run_sum = 0.0;
-    int run_count = 0;
-    for (const EstimatorOutput& out : batch.outputs) {
-      const size_t k = frame_at.at(out.t_ns);
-      if (!out.covariance_ok || k < 20) continue;
-      if (run.frames[k].mono.size() < 3 && run.frames[k].stereo.size() < 3) continue;
-      const Pose3& truth = run.truth[k].T_D_B;
-      Eigen::Matrix<double, 6, 1> e;
-      e.head<3>() = out.T_D_B.p - truth.p;
-      const Eigen::AngleAxisd aa(out.T_D_B.q * truth.q.conjugate());
-      e.tail<3>() = aa.angle() * aa.axis();
-      run_sum += e.dot(out.covariance.ldlt().solve(e));
-      ++run_count;
-    }
-    ASSERT_GT(run_count, 250) << seed;
-    std::printf("seed %2llu: smoother mean NEES %.2f over %d frames\n",
-                static_cast<unsigned long long>(seed), run_sum / run_count, run_count);
-    sum += run_sum;
-    count += run_count;
+    for (const EstimatorOutput& out : batch.outputs) tally.Add(run, frame_at.at(out.t_ns), out);
   }
-  const double mean = sum / count;
-  std::printf("smoother mean NEES over 10 seeds: %.3f (%d frames)\n", mean, count);
-  EXPECT_GT(mean, 4.5);
-  EXPECT_LT(mean, 8.0);
+  tally.Check(kRuns, 0.80, "batch smoother");
 }
 
 }  // namespace

@@ -5,7 +5,16 @@
 //   mono   MonoReprojectionFactor (2): raw pixel against the projected dock light, whitened by
 //          the detection's pixel sigma;
 //   stereo StereoPointFactor (3): triangulated p_S against the dock light, whitened by the
-//          triangulation covariance.
+//          triangulation covariance -- by default evaluated at the light's position predicted
+//          from the pose block's value when the factor is added (the IMU prediction in the
+//          sliding window, the warm start in the batch smoother), not at the measured point:
+//          the first-order covariance grows as z^4 (depth sigma ~ z^2 / (f b)), so evaluated at
+//          the noisy point it gives more weight to the lights whose noise made them come out
+//          nearer, which biases the fit towards the cameras and makes the covariance of a pose
+//          fitted over many frames too small. On 10 seeded synthetic runs this took the batch
+//          smoother's position NEES over the far-range stereo stage from 4.6 to 3.3 (3-dof) and
+//          the sliding window's from 3.35 to 2.8. The measured-point covariance is used when the
+//          light does not project into both cameras or the option is off.
 // Each gets a Huber loss (threshold huber_sigmas on the whitened norm) scaled by the frame's
 // stage weight for its camera system (estimator/stage_weighting.h): the weight multiplies the
 // residual's information, which is the source paper's stage weighting inside the problem.
@@ -28,6 +37,7 @@ struct VisionFactorOptions {
   bool use_mono = true;
   bool use_stereo = true;
   double huber_sigmas = 2.5;
+  bool stereo_covariance_at_prediction = true;
   StageWeightingOptions stage_weighting;
 };
 
@@ -36,9 +46,11 @@ struct VisionResidual {
   bool mono = false;
 };
 
-// What the factors need to know about the rig and the dock. stereo_left / mono may be null.
+// What the factors need to know about the rig and the dock. Any camera may be null (without
+// stereo_right the stereo covariance is the measured point's).
 struct VisionRig {
   const CameraCalibration* stereo_left = nullptr;
+  const CameraCalibration* stereo_right = nullptr;
   const CameraCalibration* mono = nullptr;
   const DockModel* dock = nullptr;
 };

@@ -1,0 +1,82 @@
+#include "auvdock/estimator/vision_factors.h"
+
+#include <algorithm>
+#include <memory>
+
+#include <ceres/problem.h>
+#include <gtest/gtest.h>
+
+#include "auvdock/sim/scenario.h"
+#include "auvdock/vision/stereo_triangulation.h"
+#include "factors/pose_manifold.h"
+#include "tests/testing/test_scenarios.h"
+
+namespace auvdock {
+namespace {
+
+// A stereo light 9 m ahead, measured 0.4 m nearer than it is (a large depth error at that
+// range). With stereo_covariance_at_prediction the residual is whitened by the triangulation
+// covariance at the light's predicted position (from the pose block); without it, by the
+// measured point's, which is smaller (sigma_z ~ z^2) and so makes the same error look larger.
+TEST(VisionFactorsTest, StereoCovarianceIsTakenAtThePredictedLight) {
+  const Scenario scenario = test::DefaultScenario();
+  const Calibration calibration = MakeCalibration(scenario);
+  VisionRig rig;
+  rig.stereo_left = calibration.FindCameraByRole(CameraRole::kStereoLeft);
+  rig.stereo_right = calibration.FindCameraByRole(CameraRole::kStereoRight);
+  rig.dock = &scenario.dock;
+  ASSERT_NE(rig.stereo_left, nullptr);
+  ASSERT_NE(rig.stereo_right, nullptr);
+
+  // The body placed so that the dock's first light is 9 m in front of the left camera.
+  const DockLight& light = scenario.dock.lights.front();
+  const Pose3 T_S_D(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.1, -0.2, 9.0) - light.p_D);
+  const Pose3 T_D_B = (rig.stereo_left->T_B_C * T_S_D).Inverse();
+  double pose[kPoseSize];
+  std::copy(T_D_B.p.data(), T_D_B.p.data() + 3, pose);
+  std::copy(T_D_B.q.coeffs().data(), T_D_B.q.coeffs().data() + 4, pose + 3);
+
+  const Eigen::Vector3d p_S_true = T_S_D * light.p_D;
+  const Eigen::Vector3d p_S_measured = p_S_true * (8.6 / p_S_true.z());
+  const auto project = [&](const CameraCalibration& c, const Eigen::Vector3d& p_S) {
+    const Eigen::Vector3d p_B = rig.stereo_left->T_B_C * p_S;
+    return *c.intrinsics.Project(c.T_B_C.Inverse() * p_B);
+  };
+  const double sigma = rig.stereo_left->pixel_noise_px;
+  const Eigen::Matrix3d at_truth =
+      TriangulateLinear(project(*rig.stereo_left, p_S_true), project(*rig.stereo_right, p_S_true),
+                        *rig.stereo_left, *rig.stereo_right, sigma)
+          .covariance;
+  const Eigen::Matrix3d at_measured =
+      TriangulateLinear(project(*rig.stereo_left, p_S_measured),
+                        project(*rig.stereo_right, p_S_measured), *rig.stereo_left,
+                        *rig.stereo_right, sigma)
+          .covariance;
+  ASSERT_LT(at_measured(2, 2), at_truth(2, 2));
+
+  VisionFrame frame;
+  frame.stereo.push_back({light.id, p_S_measured, at_measured});
+  const Eigen::Vector3d e = p_S_measured - p_S_true;
+  for (const bool at_prediction : {true, false}) {
+    ceres::Problem::Options problem_options;
+    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem problem(problem_options);
+    PoseManifold manifold;
+    problem.AddParameterBlock(pose, kPoseSize, &manifold);
+    VisionFactorOptions options;
+    options.use_mono = false;
+    options.stereo_covariance_at_prediction = at_prediction;
+    int skipped = 0;
+    const std::vector<VisionResidual> residuals =
+        AddVisionFactors(&problem, frame, rig, options, pose, &skipped);
+    ASSERT_EQ(residuals.size(), 1u);
+    double cost = 0.0;
+    problem.EvaluateResidualBlock(residuals[0].id, false, &cost, nullptr, nullptr);
+    const Eigen::Matrix3d& expected_covariance = at_prediction ? at_truth : at_measured;
+    EXPECT_NEAR(2.0 * cost, e.dot(expected_covariance.ldlt().solve(e)),
+                1e-6 * (2.0 * cost)) << at_prediction;
+  }
+}
+
+}  // namespace
+}  // namespace auvdock
