@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace auvdock {
@@ -98,6 +99,22 @@ cv::Mat MinFilterTyped(const cv::Mat& src, int window) {
   return result;
 }
 
+#if CV_SIMD128
+// 16 BGR pixels from `in` as floats: (*f)[c][k] holds channel c of pixels 4k .. 4k + 3.
+inline void ExpandToFloat(const uint8_t* in, std::array<std::array<cv::v_float32x4, 4>, 3>* f) {
+  std::array<cv::v_uint8x16, 3> bgr;
+  cv::v_load_deinterleave(in, bgr[0], bgr[1], bgr[2]);
+  for (int c = 0; c < 3; ++c) {
+    cv::v_uint16x8 low, high;
+    cv::v_expand(bgr[c], low, high);
+    std::array<cv::v_uint32x4, 4> words;
+    cv::v_expand(low, words[0], words[1]);
+    cv::v_expand(high, words[2], words[3]);
+    for (int k = 0; k < 4; ++k) (*f)[c][k] = cv::v_cvt_f32(cv::v_reinterpret_as_s32(words[k]));
+  }
+}
+#endif
+
 // Per-pixel minimum over the colour channels, CV_8U.
 cv::Mat ChannelMinimum(const cv::Mat& image) {
   if (image.channels() == 1) return image.clone();
@@ -105,7 +122,15 @@ cv::Mat ChannelMinimum(const cv::Mat& image) {
   for (int y = 0; y < image.rows; ++y) {
     const uint8_t* in = image.ptr<uint8_t>(y);
     uint8_t* out = result.ptr<uint8_t>(y);
-    for (int x = 0; x < image.cols; ++x, in += 3) out[x] = std::min({in[0], in[1], in[2]});
+    int x = 0;
+#if CV_SIMD128
+    for (; x + 16 <= image.cols; x += 16) {
+      cv::v_uint8x16 b, g, r;
+      cv::v_load_deinterleave(in + 3 * x, b, g, r);
+      cv::v_store(out + x, cv::v_min(cv::v_min(b, g), r));
+    }
+#endif
+    for (; x < image.cols; ++x) out[x] = std::min({in[3 * x], in[3 * x + 1], in[3 * x + 2]});
   }
   return result;
 }
@@ -142,6 +167,10 @@ cv::Vec3d AtmosphericLight(const cv::Mat& image, const cv::Mat& dark, int count)
   for (int y = 0; y < dark.rows; ++y) {
     const uint8_t* d = dark.ptr<uint8_t>(y);
     const uint8_t* in = image.ptr<uint8_t>(y);
+    // Most rows hold none of the 0.1 % brightest: a vectorised maximum rules them out.
+    uint8_t row_max = 0;
+    for (int x = 0; x < dark.cols; ++x) row_max = std::max(row_max, d[x]);
+    if (row_max < level) continue;
     for (int x = 0; x < dark.cols; ++x) {
       const bool take = d[x] > level || (d[x] == level && at_level_wanted-- > 0);
       if (!take) continue;
@@ -240,8 +269,23 @@ DarkChannelDehazer::Result DarkChannelDehazer::Dehaze(const cv::Mat& bgr8) const
     const uint8_t* in = bgr8.ptr<uint8_t>(y);
     float* out = normalized_min.ptr<float>(y);
     if (channels == 3) {
-      for (int x = 0; x < cols; ++x, in += 3) {
-        out[x] = std::min({in[0] * inv_a[0], in[1] * inv_a[1], in[2] * inv_a[2]});
+      int x = 0;
+#if CV_SIMD128
+      const cv::v_float32x4 inv_b4 = cv::v_setall_f32(inv_a[0]);
+      const cv::v_float32x4 inv_g4 = cv::v_setall_f32(inv_a[1]);
+      const cv::v_float32x4 inv_r4 = cv::v_setall_f32(inv_a[2]);
+      for (; x + 16 <= cols; x += 16) {
+        std::array<std::array<cv::v_float32x4, 4>, 3> f;
+        ExpandToFloat(in + 3 * x, &f);
+        for (int k = 0; k < 4; ++k) {
+          cv::v_store(out + x + 4 * k, cv::v_min(cv::v_min(f[0][k] * inv_b4, f[1][k] * inv_g4),
+                                                 f[2][k] * inv_r4));
+        }
+      }
+#endif
+      for (; x < cols; ++x) {
+        const uint8_t* pixel = in + 3 * x;
+        out[x] = std::min({pixel[0] * inv_a[0], pixel[1] * inv_a[1], pixel[2] * inv_a[2]});
       }
     } else {
       for (int x = 0; x < cols; ++x) out[x] = in[x] * inv_a[0];
@@ -272,7 +316,31 @@ DarkChannelDehazer::Result DarkChannelDehazer::Dehaze(const cv::Mat& bgr8) const
     const uint8_t* in = bgr8.ptr<uint8_t>(y);
     const float* t = transmission.ptr<float>(y);
     uint8_t* out = result.image.ptr<uint8_t>(y);
-    for (int x = 0; x < cols; ++x) {
+    int x = 0;
+#if CV_SIMD128
+    // The scalar loop's arithmetic lane by lane, in the same order and precision (float
+    // subtract, multiply, add; round to nearest even as cvRound; saturate to 0-255 as
+    // saturate_cast), so the output is bit-identical.
+    if (channels == 3) {
+      const cv::v_float32x4 one = cv::v_setall_f32(1.0f);
+      const std::array<cv::v_float32x4, 3> a4{cv::v_setall_f32(a[0]), cv::v_setall_f32(a[1]),
+                                              cv::v_setall_f32(a[2])};
+      for (; x + 16 <= cols; x += 16, in += 48, out += 48) {
+        std::array<cv::v_float32x4, 4> inv_t;
+        for (int k = 0; k < 4; ++k) inv_t[k] = one / cv::v_load(t + x + 4 * k);
+        std::array<std::array<cv::v_float32x4, 4>, 3> f;
+        ExpandToFloat(in, &f);
+        std::array<cv::v_uint8x16, 3> packed;
+        for (int c = 0; c < 3; ++c) {
+          std::array<cv::v_int32x4, 4> j;
+          for (int k = 0; k < 4; ++k) j[k] = cv::v_round((f[c][k] - a4[c]) * inv_t[k] + a4[c]);
+          packed[c] = cv::v_pack_u(cv::v_pack(j[0], j[1]), cv::v_pack(j[2], j[3]));
+        }
+        cv::v_store_interleave(out, packed[0], packed[1], packed[2]);
+      }
+    }
+#endif
+    for (; x < cols; ++x) {
       const float inv_t = 1.0f / t[x];
       for (int c = 0; c < channels; ++c, ++in, ++out) {
         *out = cv::saturate_cast<uint8_t>((*in - a[c]) * inv_t + a[c]);

@@ -299,7 +299,9 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
   const int num_samples = static_cast<int>(samples.size());
   Eigen::Matrix<float, Eigen::Dynamic, kParams, Eigen::RowMajor> weighted_j(num_samples, kParams);
   Eigen::VectorXf weighted_r(num_samples);
-  auto evaluate = [&](const Vec& p, Mat* jtj, Vec* jtr, double* weighted_sq) {
+  // Fills the weighted rows and residuals; returns the robust cost and the weighted squared
+  // residual sum.
+  auto evaluate = [&](const Vec& p, double* sum_sq) {
     const double u = p[0], v = p[1], s = std::exp(p[2]), a = p[3];
     const double inv_s2 = 1.0 / (s * s);
     double ur = 0.0, vr = 0.0, inv_sr2 = 0.0, ar = 0.0;
@@ -329,10 +331,8 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
         model += ar * gr;
       }
       if (q.clipped && model >= kFullScale) {
-        if (jtj) {
-          weighted_j.row(i).setZero();
-          weighted_r[i] = 0.0f;
-        }
+        weighted_j.row(i).setZero();
+        weighted_r[i] = 0.0f;
         continue;
       }
       const double r = q.value - model;
@@ -351,7 +351,6 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
         cost += position_weight * 0.5 * r * r;
       }
       wsq += sqrt_w * sqrt_w * r * r;
-      if (!jtj) continue;
       float* j = weighted_j.row(i).data();
       weighted_r[i] = static_cast<float>(sqrt_w * r);
       const double ag = sqrt_w * a * g * inv_s2;
@@ -373,21 +372,26 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
         j[kR + 3] = sqrt_w * gr;
       }
     }
-    if (jtj) {
-      Eigen::Matrix<float, kParams, kParams> h = Eigen::Matrix<float, kParams, kParams>::Zero();
-      h.template selfadjointView<Eigen::Lower>().rankUpdate(weighted_j.transpose());
-      *jtj = h.template cast<double>().template selfadjointView<Eigen::Lower>();
-      *jtr = (weighted_j.transpose() * weighted_r).template cast<double>();
-    }
-    if (weighted_sq) *weighted_sq = wsq;
+    *sum_sq = wsq;
     return cost;
   };
+  // The normal equations of the rows the last evaluate() with the Jacobian wrote.
+  auto normal_equations = [&](Mat* jtj, Vec* jtr) {
+    Eigen::Matrix<float, kParams, kParams> h = Eigen::Matrix<float, kParams, kParams>::Zero();
+    h.template selfadjointView<Eigen::Lower>().rankUpdate(weighted_j.transpose());
+    *jtj = h.template cast<double>().template selfadjointView<Eigen::Lower>();
+    *jtr = (weighted_j.transpose() * weighted_r).template cast<double>();
+  };
 
-  // Levenberg-Marquardt where a trial point is evaluated with its Jacobian at once: accepted,
-  // its normal equations are ready for the next step; rejected, only the damping changes.
-  Mat jtj, trial_jtj;
-  Vec jtr, trial_jtr;
-  double cost = evaluate(theta, &jtj, &jtr, nullptr);
+  // Levenberg-Marquardt where a trial point is evaluated with its Jacobian rows at once:
+  // accepted, its normal equations (the rank update, ~40 % of a fit) are formed for the next
+  // step; rejected, only the damping changes. The weighted squared residual of the accepted
+  // point is kept for the RMS instead of a last evaluation.
+  Mat jtj;
+  Vec jtr;
+  double weighted_sq = 0.0;
+  double cost = evaluate(theta, &weighted_sq);
+  normal_equations(&jtj, &jtr);
   double lambda = 1e-3;
   for (int iteration = 0; iteration < max_iterations; ++iteration) {
     Mat damped = jtj;
@@ -405,12 +409,13 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
       candidate[kR + 2] = std::clamp(candidate[kR + 2], candidate[2], candidate[2] + std::log(2.5));
       candidate[kR + 3] = std::clamp(candidate[kR + 3], 0.0, std::max(0.0, candidate[3]));
     }
-    const double candidate_cost = evaluate(candidate, &trial_jtj, &trial_jtr, nullptr);
+    double candidate_weighted_sq = 0.0;
+    const double candidate_cost = evaluate(candidate, &candidate_weighted_sq);
     if (candidate_cost < cost) {
       theta = candidate;
       cost = candidate_cost;
-      jtj = trial_jtj;
-      jtr = trial_jtr;
+      weighted_sq = candidate_weighted_sq;
+      normal_equations(&jtj, &jtr);
       lambda = std::max(1e-7, lambda * 0.3);
       if (std::abs(step[0]) < 5e-3 && std::abs(step[1]) < 5e-3) break;
     } else {
@@ -418,8 +423,6 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
       if (lambda > 1e6) break;
     }
   }
-  double weighted_sq = 0.0;
-  evaluate(theta, nullptr, nullptr, &weighted_sq);
   FitResult result;
   result.u = theta[0];
   result.v = theta[1];

@@ -55,7 +55,7 @@
 // Dehazing (seed 000's dark-channel enhancement, DarkChannelDehazer) is off by default: on the
 // test run (default docking run, 3 cameras, every 4th frame) it lowered recall to 0.986-0.994,
 // precision to 0.957-0.994 and raised the centroid RMS to 0.26-0.33 px in clear, coastal and
-// turbid water, and costs ~4 ms per 640 x 512 frame. It rescales contrast by 1 / t, with t from a
+// turbid water, and costs ~1 ms per 640 x 512 frame. It rescales contrast by 1 / t, with t from a
 // 15 px minimum filter that changes across a light's blob and halos around it; noise is scaled
 // by the same gain, so it adds no signal, and the local background subtraction already does for
 // detection what dehazing does for display.
