@@ -67,7 +67,29 @@ void AddInitialPriors(ceres::Problem* problem, const EstimatorOptions& o, BatchS
                             nullptr, s->bias);
 }
 
+// Median interval between consecutive states (s); 0 with fewer than two states.
+double MedianStateInterval(const std::vector<std::unique_ptr<BatchState>>& states) {
+  std::vector<double> intervals;
+  for (size_t k = 1; k < states.size(); ++k) {
+    intervals.push_back(1e-9 * static_cast<double>(states[k]->t_ns - states[k - 1]->t_ns));
+  }
+  if (intervals.empty()) return 0.0;
+  std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2, intervals.end());
+  return intervals[intervals.size() / 2];
+}
+
 }  // namespace
+
+double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
+                                double frame_interval_s) {
+  const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
+  if (!positive(floor_px) || !positive(correlation_time_s) || !positive(frame_interval_s)) {
+    return 0.0;
+  }
+  const double one_minus_rho = -std::expm1(-frame_interval_s / correlation_time_s);
+  const double n_c = (2.0 - one_minus_rho) / one_minus_rho;  // (1 + rho) / (1 - rho)
+  return n_c * floor_px * floor_px;
+}
 
 BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
                         const std::vector<VisionFrame>& frames,
@@ -101,6 +123,11 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     states.push_back(std::move(s));
   }
 
+  VisionFactorOptions vision_options = estimator_options.vision;
+  vision_options.correlated_pixel_variance = CorrelatedVisionVariance(
+      estimator_options.smoother_vision_floor_px,
+      estimator_options.smoother_vision_correlation_time_s, MedianStateInterval(states));
+
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.enable_fast_removal = true;
@@ -130,7 +157,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     }
     const auto f = frame_at.find(s->t_ns);
     if (f != frame_at.end()) {
-      s->vision = AddVisionFactors(&problem, *f->second, rig, estimator_options.vision, s->pose,
+      s->vision = AddVisionFactors(&problem, *f->second, rig, vision_options, s->pose,
                                    &result.stats.skipped_observations);
     }
   }

@@ -35,6 +35,10 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.init_velocity_sigma_mps = est.GetPositive("init_velocity_sigma_mps", e.init_velocity_sigma_mps);
   e.init_gyro_bias_sigma = est.GetPositive("init_gyro_bias_sigma", e.init_gyro_bias_sigma);
   e.init_accel_bias_sigma = est.GetPositive("init_accel_bias_sigma", e.init_accel_bias_sigma);
+  e.smoother_vision_floor_px =
+      est.GetNonNegative("smoother_vision_floor_px", e.smoother_vision_floor_px);
+  e.smoother_vision_correlation_time_s = est.GetNonNegative("smoother_vision_correlation_time_s",
+                                                            e.smoother_vision_correlation_time_s);
 
   GoNoGoOptions& g = config.go_no_go;
   const ConfigNode go = root.ChildOrEmpty("go_no_go");

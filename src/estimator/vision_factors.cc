@@ -52,6 +52,13 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
   const int n_mono = mono ? static_cast<int>(frame.mono.size()) : 0;
   const int n_stereo = stereo ? static_cast<int>(frame.stereo.size()) : 0;
   const StageWeights weights = StageWeighting(options.stage_weighting).Compute(n_stereo, n_mono);
+  // The triangulation covariance is J (sigma^2 I) J^T: adding a variance to every pixel
+  // coordinate of the pair scales it.
+  double stereo_scale = 1.0;
+  if (stereo && options.correlated_pixel_variance > 0.0) {
+    const double sigma2 = rig.stereo_left->pixel_noise_px * rig.stereo_left->pixel_noise_px;
+    if (sigma2 > 0.0) stereo_scale = (sigma2 + options.correlated_pixel_variance) / sigma2;
+  }
   for (int i = 0; i < n_mono; ++i) {
     const MonoLightObservation& obs = frame.mono[i];
     const DockLight* light = rig.dock->FindLight(obs.light_id);
@@ -59,7 +66,9 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
       ++*n_skipped;
       continue;
     }
-    const Eigen::Matrix2d covariance = Eigen::Matrix2d::Identity() * obs.sigma_px * obs.sigma_px;
+    const Eigen::Matrix2d covariance =
+        Eigen::Matrix2d::Identity() *
+        (obs.sigma_px * obs.sigma_px + options.correlated_pixel_variance);
     const ceres::ResidualBlockId id = problem->AddResidualBlock(
         MonoReprojectionFactor::Create(obs.uv, covariance, rig.mono->intrinsics, rig.mono->T_B_C,
                                        light->p_D),
@@ -81,7 +90,7 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
       }
     }
     const ceres::ResidualBlockId id = problem->AddResidualBlock(
-        StereoPointFactor::Create(obs.p_S, covariance, rig.stereo_left->T_B_C, light->p_D),
+        StereoPointFactor::Create(obs.p_S, stereo_scale * covariance, rig.stereo_left->T_B_C, light->p_D),
         WeightedHuber(options.huber_sigmas, weights.stereo), pose);
     added.push_back({id, false});
   }

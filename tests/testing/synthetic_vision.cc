@@ -1,5 +1,7 @@
 #include "tests/testing/synthetic_vision.h"
 
+#include <cmath>
+
 #include "auvdock/sim/docking_simulator.h"
 #include "auvdock/sim/imu_simulator.h"
 #include "auvdock/sim/random_stream.h"
@@ -25,6 +27,14 @@ std::optional<Eigen::Vector2d> See(const CameraCalibration& camera, const Pose3&
 }  // namespace
 
 SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed, double pixel_sigma) {
+  SyntheticPixelNoise noise;
+  noise.white_px = pixel_sigma;
+  return MakeSyntheticRun(scenario, seed, noise);
+}
+
+SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
+                              const SyntheticPixelNoise& noise) {
+  const double pixel_sigma = noise.white_px;
   const DockingSimulator simulator(scenario);
   SyntheticRun run;
   run.calibration = simulator.calibration();
@@ -44,24 +54,40 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed, double pi
 
   std::mt19937_64 rng = MakeRandomStream(seed, 102);
   const double rate = left ? left->rate_hz : mono->rate_hz;
+  // Per-camera slow offsets (left, right, mono): stationary AR(1) at the frame interval.
+  std::mt19937_64 offset_rng = MakeRandomStream(seed, 103);
+  const double rho =
+      noise.correlated_px > 0.0 ? std::exp(-1.0 / (rate * noise.correlation_time_s)) : 0.0;
+  Eigen::Vector2d offset[3];
+  for (Eigen::Vector2d& o : offset) {
+    o = noise.correlated_px *
+        Eigen::Vector2d(StandardNormal(offset_rng), StandardNormal(offset_rng));
+  }
   for (int64_t k = 0;; ++k) {
     const int64_t t = simulator.SampleTime(k, rate);
     if (simulator.Seconds(t) > scenario.duration_s) break;
     const Pose3 T_D_B = simulator.trajectory().At(simulator.Seconds(t)).T_D_B;
     VisionFrame frame;
     frame.t_ns = t;
+    if (k > 0) {
+      const double innovation = noise.correlated_px * std::sqrt(1.0 - rho * rho);
+      for (Eigen::Vector2d& o : offset) {
+        o = rho * o +
+            innovation * Eigen::Vector2d(StandardNormal(offset_rng), StandardNormal(offset_rng));
+      }
+    }
     for (const DockLight& light : run.dock.lights) {
       if (mono) {
         if (const auto uv = See(*mono, T_D_B, light.p_D, pixel_sigma, rng)) {
-          frame.mono.push_back({light.id, *uv, pixel_sigma});
+          frame.mono.push_back({light.id, *uv + offset[2], pixel_sigma});
         }
       }
       if (left && right) {
         const auto uv_left = See(*left, T_D_B, light.p_D, pixel_sigma, rng);
         const auto uv_right = See(*right, T_D_B, light.p_D, pixel_sigma, rng);
         if (uv_left && uv_right) {
-          const TriangulatedPoint p =
-              TriangulateLinear(*uv_left, *uv_right, *left, *right, pixel_sigma);
+          const TriangulatedPoint p = TriangulateLinear(*uv_left + offset[0], *uv_right + offset[1],
+                                                        *left, *right, pixel_sigma);
           if (p.ok) frame.stereo.push_back({light.id, p.p_S, p.covariance});
         }
       }

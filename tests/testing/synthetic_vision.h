@@ -27,4 +27,17 @@ struct SyntheticRun {
 
 SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed, double pixel_sigma = 0.3);
 
+// Pixel errors that are not white, like the image pipeline's (README, "Vision noise"): white
+// noise per light and frame plus a slowly varying offset common to all lights of one camera,
+// a stationary AR(1) process per camera and pixel coordinate with 1-sigma correlated_px and
+// autocorrelation exp(-|t| / correlation_time_s) (drawn from its own random stream, so the
+// white draws are those of the overload above). The cameras' pixel_noise_px is white_px.
+struct SyntheticPixelNoise {
+  double white_px = 0.3;
+  double correlated_px = 0.0;
+  double correlation_time_s = 1.0;
+};
+SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
+                              const SyntheticPixelNoise& noise);
+
 }  // namespace auvdock::test

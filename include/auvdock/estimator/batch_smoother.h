@@ -11,6 +11,32 @@
 // The marginal covariance of every pose comes from ceres::Covariance (SPARSE_QR, SuiteSparse),
 // in the PoseManifold tangent space; a rank-deficient problem reports no covariance rather than
 // a wrong one.
+//
+// Time-correlated vision errors. The image pipeline's light centres are not white: besides the
+// frame-to-frame scatter (which the cameras' pixel_noise_px covers) they carry a slowly varying
+// error of ~0.1 px, mostly along the image v axis and common to the lights of one camera (the
+// detector's fit of each light's reflection, which the renderer draws below it; README, "Vision
+// noise": on the default scenario the per-camera mean v error keeps an autocorrelation of
+// 0.78 / 0.57 after 1 s / 4 s in the stereo-left camera). A sliding window fuses about a second
+// of frames and stays honest with pixel_noise_px; the smoother fuses every frame of the log as
+// if independent, and the slow error, which does not average out over frames, would shrink the
+// reported covariance with the number of frames. Model: per pixel coordinate, error = white
+// (pixel_noise_px) + a stationary slow part of 1-sigma s (EstimatorOptions::
+// smoother_vision_floor_px) with the autocorrelation exp(-|t| / tau) (smoother_vision_
+// correlation_time_s), i.e. AR(1) with rho = exp(-dt / tau)
+// at the frame interval dt. Over n >> 1 / (1 - rho) frames the mean of that part has the
+// variance s^2 N_c / n with N_c = (1 + rho) / (1 - rho) (~2 tau / dt): the frames carry the
+// information of n / N_c independent looks, one per ~2 tau. Least squares over frames treated as
+// independent reports that variance when each frame's variance includes N_c s^2, so the smoother
+// adds N_c s^2 to every pixel coordinate's variance (VisionFactorOptions::
+// correlated_pixel_variance; propagated into the stereo points' triangulation covariance): the
+// effective sample size n (1 - rho) / (1 + rho) of an AR(1) series, applied to the correlated
+// part only. It is a de-weighting inside the problem - the estimate and its covariance both
+// follow from it - not a scaling of the reported covariance. Gating uses the same (inflated)
+// covariances. The defaults (0.075 px, 2 s) are the measured slow variance spread over both
+// pixel coordinates and a correlation time shorter than the measured decay (4-15 s), since a
+// smoothed pose draws its vision from the seconds around it; README, "Vision noise", has the
+// measurements and the NEES with and without the model.
 #pragma once
 
 #include <functional>
@@ -34,6 +60,13 @@ struct BatchResult {
   bool converged = false;
   EstimatorStats stats;  // skipped / gated / used counts
 };
+
+// The variance (px^2) added to every pixel coordinate of the smoother's vision residuals for a
+// slow error of 1-sigma floor_px and correlation time correlation_time_s, at the frame interval
+// frame_interval_s: N_c floor_px^2, N_c = (1 + rho) / (1 - rho), rho = exp(-dt / tau). 0 when
+// any argument is 0 (or not finite and positive).
+double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
+                                double frame_interval_s);
 
 // frames: every vision frame of the log, in time order (frames without a warm-start state are
 // ignored); imu: all samples in time order. Throws std::invalid_argument without an IMU

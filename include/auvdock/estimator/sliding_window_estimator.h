@@ -80,6 +80,11 @@ struct EstimatorOptions {
   double init_gyro_bias_sigma = 0.01;   // rad/s
   double init_accel_bias_sigma = 0.1;   // m/s^2
   bool compute_covariance = true;       // marginal covariance of the newest pose every frame
+  // Batch smoother only (estimator/batch_smoother.h): the slowly varying part of the detection
+  // errors, per pixel coordinate (1-sigma, px) and its correlation time (s); either 0 = white
+  // errors only. The sliding window ignores them. README, "Vision noise".
+  double smoother_vision_floor_px = 0.075;
+  double smoother_vision_correlation_time_s = 2.0;
 };
 
 // The estimate at one state.

@@ -15,6 +15,12 @@
 //          smoother's position NEES over the far-range stereo stage from 4.6 to 3.3 (3-dof) and
 //          the sliding window's from 3.35 to 2.8. The measured-point covariance is used when the
 //          light does not project into both cameras or the option is off.
+// correlated_pixel_variance (px^2, default 0) is added to the white variance of every pixel
+// coordinate: to sigma_px^2 of a mono pixel, and to the stereo pair's pixel_noise_px^2 in its
+// triangulation covariance, which is linear in the (i.i.d.) pixel variance and so is scaled by
+// (sigma_px^2 + correlated_pixel_variance) / sigma_px^2. The batch smoother uses it for the
+// time-correlated part of the detection errors (estimator/batch_smoother.h); the sliding window
+// leaves it at 0.
 // Each gets a Huber loss (threshold huber_sigmas on the whitened norm) scaled by the frame's
 // stage weight for its camera system (estimator/stage_weighting.h): the weight multiplies the
 // residual's information, which is the source paper's stage weighting inside the problem.
@@ -39,6 +45,7 @@ struct VisionFactorOptions {
   double huber_sigmas = 2.5;
   bool stereo_covariance_at_prediction = true;
   StageWeightingOptions stage_weighting;
+  double correlated_pixel_variance = 0.0;  // px^2 added per pixel coordinate (see above)
 };
 
 struct VisionResidual {

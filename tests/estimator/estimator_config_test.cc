@@ -1,0 +1,39 @@
+// LoadRunConfig (estimator/estimator_config.h): the shipped data/estimator/default.yaml states
+// the built-in defaults, and the smoother's vision-noise keys are read and checked.
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "auvdock/estimator/estimator_config.h"
+#include "auvdock/io/input_error.h"
+#include "tests/testing/temp_dir.h"
+#include "tests/testing/test_scenarios.h"
+
+namespace auvdock {
+namespace {
+
+TEST(EstimatorConfigTest, ShippedDefaultsEqualTheBuiltInOnes) {
+  const RunConfig config = LoadRunConfig(test::SourcePath("data/estimator/default.yaml"));
+  const EstimatorOptions defaults;
+  EXPECT_EQ(config.estimator.smoother_vision_floor_px, defaults.smoother_vision_floor_px);
+  EXPECT_EQ(config.estimator.smoother_vision_correlation_time_s,
+            defaults.smoother_vision_correlation_time_s);
+  EXPECT_EQ(config.estimator.window_size, defaults.window_size);
+}
+
+TEST(EstimatorConfigTest, SmootherVisionNoiseKeys) {
+  const test::TempDir dir;
+  const std::string path = dir.path() + "/estimator.yaml";
+  {
+    std::ofstream(path) << "estimator:\n  smoother_vision_floor_px: 0.0\n"
+                           "  smoother_vision_correlation_time_s: 3.5\n";
+  }
+  const RunConfig config = LoadRunConfig(path);
+  EXPECT_EQ(config.estimator.smoother_vision_floor_px, 0.0);
+  EXPECT_EQ(config.estimator.smoother_vision_correlation_time_s, 3.5);
+  { std::ofstream(path) << "estimator:\n  smoother_vision_floor_px: -0.1\n"; }
+  EXPECT_THROW(LoadRunConfig(path), InputError);
+}
+
+}  // namespace
+}  // namespace auvdock
