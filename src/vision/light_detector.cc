@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <Eigen/Dense>
+#include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace auvdock {
@@ -247,17 +248,60 @@ struct FitResult {
   double reflection_u = 0.0, reflection_v = 0.0, reflection_sigma = 0.0, reflection_amplitude = 0.0;
 };
 
-struct FitSample {
-  float x, y, value;
-  bool clipped;
+// The samples of a fit, structure of arrays padded to a multiple of kFitLanes (padding: valid 0)
+// so that the model is evaluated four samples at a time. Coordinates are relative to an integer
+// origin near the light, so that in float they and the model's centre keep ~1e-5 px precision.
+constexpr int kFitLanes = 4;
+struct FitSamples {
+  int count = 0;       // real samples
+  int ox = 0, oy = 0;  // full-resolution pixel coordinates of the origin
+  std::vector<float> x, y, value, valid;  // padded; value is the raw pixel (255: clipped)
 };
 
 struct FitStart {
   double u, v, sigma, amplitude;
 };
 
+// exp(x) in float for x <= 0 (Cephes' expf polynomial; ~2 ulp), exactly 1 at 0: the fit's
+// Gaussians and taper, four at a time.
+inline float FastExp(float x) {
+  x = std::max(x, -87.0f);
+  const float n = std::nearbyint(x * 1.44269504088896341f);
+  const float r = x - n * 0.693359375f + n * 2.12194440e-4f;
+  float p = 1.9875691500e-4f;
+  p = p * r + 1.3981999507e-3f;
+  p = p * r + 8.3334519073e-3f;
+  p = p * r + 4.1665795894e-2f;
+  p = p * r + 1.6666665459e-1f;
+  p = p * r + 5.0000001201e-1f;
+  const float y = p * r * r + r + 1.0f;
+  const int32_t bits = (static_cast<int32_t>(n) + 127) << 23;
+  float scale;
+  std::memcpy(&scale, &bits, sizeof(scale));
+  return y * scale;
+}
+
+#if CV_SIMD128
+inline cv::v_float32x4 FastExp(cv::v_float32x4 x) {
+  x = cv::v_max(x, cv::v_setall_f32(-87.0f));
+  const cv::v_int32x4 ni = cv::v_round(x * cv::v_setall_f32(1.44269504088896341f));
+  const cv::v_float32x4 n = cv::v_cvt_f32(ni);
+  const cv::v_float32x4 r =
+      x - n * cv::v_setall_f32(0.693359375f) + n * cv::v_setall_f32(2.12194440e-4f);
+  cv::v_float32x4 p = cv::v_setall_f32(1.9875691500e-4f);
+  p = cv::v_muladd(p, r, cv::v_setall_f32(1.3981999507e-3f));
+  p = cv::v_muladd(p, r, cv::v_setall_f32(8.3334519073e-3f));
+  p = cv::v_muladd(p, r, cv::v_setall_f32(4.1665795894e-2f));
+  p = cv::v_muladd(p, r, cv::v_setall_f32(1.6666665459e-1f));
+  p = cv::v_muladd(p, r, cv::v_setall_f32(5.0000001201e-1f));
+  const cv::v_float32x4 y = p * r * r + r + cv::v_setall_f32(1.0f);
+  const cv::v_int32x4 bits = cv::v_shl<23>(ni + cv::v_setall_s32(127));
+  return y * cv::v_reinterpret_as_f32(bits);
+}
+#endif
+
 template <int kParams>
-FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start, double noise,
+FitResult FitModel(const FitSamples& samples, const FitStart& start, double noise,
                    double taper_sigmas, int max_iterations) {
   static_assert(kParams == 10 || kParams == 14, "light, or light + reflection");
   constexpr bool kReflection = kParams == 14;
@@ -266,6 +310,8 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
   using Mat = Eigen::Matrix<double, kParams, kParams>;
   const double u0 = start.u, v0 = start.v;
   const double inv_s0 = 1.0 / std::max(0.5, start.sigma);
+  const int num_samples = samples.count;
+  const int padded = static_cast<int>(samples.x.size());
   Vec theta;
   theta.setZero();
   theta[0] = start.u;
@@ -275,8 +321,13 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
   {
     // Start the background offset at the median level of the window's outer samples.
     std::vector<float> outer;
-    for (const FitSample& q : samples) {
-      if (std::hypot(q.x - start.u, q.y - start.v) > 2.5 * start.sigma) outer.push_back(q.value);
+    const double ru = start.u - samples.ox, rv = start.v - samples.oy;
+    const double outer_radius2 = (2.5 * start.sigma) * (2.5 * start.sigma);
+    for (int i = 0; i < num_samples; ++i) {
+      const double dx = samples.x[i] - ru, dy = samples.y[i] - rv;
+      if (dx * dx + dy * dy > outer_radius2) {
+        outer.push_back(samples.value[i]);
+      }
     }
     if (!outer.empty()) {
       std::nth_element(outer.begin(), outer.begin() + outer.size() / 2, outer.end());
@@ -292,90 +343,191 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
   }
   noise = std::max(0.5, noise);
 
-  // The weighted Jacobian rows sqrt(w_i) J_i and residuals sqrt(w_i) r_i of all samples, in
-  // float: the normal equations are then one symmetric rank-k update (vectorised by Eigen)
-  // instead of a scalar per-sample loop, ~3x faster; float's 1e-7 relative error in J^T W J and
-  // J^T W r moves the converged centre by far less than 1e-3 px.
-  const int num_samples = static_cast<int>(samples.size());
-  Eigen::Matrix<float, Eigen::Dynamic, kParams, Eigen::RowMajor> weighted_j(num_samples, kParams);
-  Eigen::VectorXf weighted_r(num_samples);
-  // Fills the weighted rows and residuals; returns the robust cost and the weighted squared
+  // The background's basis (x - u0, y - v0) / s0 and its products, fixed during the fit.
+  std::array<std::vector<float>, 5> basis;
+  for (std::vector<float>& b : basis) b.resize(padded);
+  for (int i = 0; i < padded; ++i) {
+    const double qx = (samples.x[i] + (samples.ox - u0)) * inv_s0;
+    const double qy = (samples.y[i] + (samples.oy - v0)) * inv_s0;
+    basis[0][i] = static_cast<float>(qx);
+    basis[1][i] = static_cast<float>(qy);
+    basis[2][i] = static_cast<float>(qx * qx);
+    basis[3][i] = static_cast<float>(qx * qy);
+    basis[4][i] = static_cast<float>(qy * qy);
+  }
+
+  // The weighted Jacobian columns sqrt(w_i) J_i and residuals sqrt(w_i) r_i of all samples, in
+  // float: the normal equations are then one symmetric rank-k update (vectorised by Eigen).
+  // The model, its Jacobian and the weights are evaluated in float too, four samples at a time
+  // with a polynomial exp: float's ~1e-7 relative error moves the converged centre by ~1e-6 px.
+  Eigen::Matrix<float, Eigen::Dynamic, kParams> weighted_j(padded, kParams);
+  Eigen::VectorXf weighted_r(padded);
+  // Fills the weighted columns and residuals; returns the robust cost and the weighted squared
   // residual sum.
   auto evaluate = [&](const Vec& p, double* sum_sq) {
-    const double u = p[0], v = p[1], s = std::exp(p[2]), a = p[3];
-    const double inv_s2 = 1.0 / (s * s);
-    double ur = 0.0, vr = 0.0, inv_sr2 = 0.0, ar = 0.0;
+    const double s = std::exp(p[2]);
+    const float u = static_cast<float>(p[0] - samples.ox);
+    const float v = static_cast<float>(p[1] - samples.oy);
+    const float a = static_cast<float>(p[3]);
+    const float inv_s2 = static_cast<float>(1.0 / (s * s));
+    const float gauss = -0.5f * inv_s2;
+    std::array<float, 6> b;
+    for (int k = 0; k < 6; ++k) b[k] = static_cast<float>(p[4 + k]);
+    float ur = 0.0f, vr = 0.0f, inv_sr2 = 0.0f, ar = 0.0f;
     if constexpr (kReflection) {
-      ur = p[kR];
-      vr = p[kR + 1];
-      inv_sr2 = std::exp(-2.0 * p[kR + 2]);
-      ar = p[kR + 3];
+      ur = static_cast<float>(p[kR] - samples.ox);
+      vr = static_cast<float>(p[kR + 1] - samples.oy);
+      inv_sr2 = static_cast<float>(std::exp(-2.0 * p[kR + 2]));
+      ar = static_cast<float>(p[kR + 3]);
     }
-    const double scale = std::max(3.0 * noise, 0.05 * std::abs(a));
+    const float gauss_r = -0.5f * inv_sr2;
+    const double scale = std::max(3.0 * noise, 0.05 * std::abs(p[3]));
+    const float inv_scale = static_cast<float>(1.0 / scale);
+    const float half_scale2 = static_cast<float>(0.5 * scale * scale);
     const double taper = taper_sigmas * s;
+    const bool tapered = taper > 0.0;
+    const float taper_k = tapered ? static_cast<float>(-0.25 / (taper * taper)) : 0.0f;
+    std::array<float*, kParams> j;
+    for (int k = 0; k < kParams; ++k) j[k] = weighted_j.col(k).data();
+    float* wr_out = weighted_r.data();
+    const float* xs = samples.x.data();
+    const float* ys = samples.y.data();
+    const float* values = samples.value.data();
+    const float* valid = samples.valid.data();
     double cost = 0.0, wsq = 0.0;
-    for (int i = 0; i < num_samples; ++i) {
-      const FitSample& q = samples[i];
-      const double dx = q.x - u, dy = q.y - v;
-      const double r2 = dx * dx + dy * dy;
-      const double g = std::exp(static_cast<float>(-0.5 * r2 * inv_s2));
-      const double qx = (q.x - u0) * inv_s0, qy = (q.y - v0) * inv_s0;
-      double model = p[4] + p[5] * qx + p[6] * qy + p[7] * qx * qx + p[8] * qx * qy +
-                     p[9] * qy * qy + a * g;
-      double gr = 0.0, dxr = 0.0, dyr = 0.0, rr2 = 0.0;
+#if CV_SIMD128
+    using cv::v_float32x4;
+    const v_float32x4 u4 = cv::v_setall_f32(u), v4 = cv::v_setall_f32(v);
+    const v_float32x4 a4 = cv::v_setall_f32(a), gauss4 = cv::v_setall_f32(gauss);
+    const v_float32x4 inv_s2_4 = cv::v_setall_f32(inv_s2);
+    const v_float32x4 zero = cv::v_setzero_f32(), one = cv::v_setall_f32(1.0f);
+    const v_float32x4 half = cv::v_setall_f32(0.5f), full = cv::v_setall_f32(kFullScale);
+    const v_float32x4 inv_scale4 = cv::v_setall_f32(inv_scale);
+    const v_float32x4 half_scale2_4 = cv::v_setall_f32(half_scale2);
+    const v_float32x4 taper4 = cv::v_setall_f32(taper_k);
+    std::array<v_float32x4, 6> b4;
+    for (int k = 0; k < 6; ++k) b4[k] = cv::v_setall_f32(b[k]);
+    const v_float32x4 ur4 = cv::v_setall_f32(ur), vr4 = cv::v_setall_f32(vr);
+    const v_float32x4 ar4 = cv::v_setall_f32(ar), gauss_r4 = cv::v_setall_f32(gauss_r);
+    const v_float32x4 inv_sr2_4 = cv::v_setall_f32(inv_sr2);
+    cv::v_float64x2 cost2 = cv::v_setzero_f64(), wsq2 = cv::v_setzero_f64();
+    for (int i = 0; i < padded; i += kFitLanes) {
+      const v_float32x4 dx = cv::v_load(xs + i) - u4, dy = cv::v_load(ys + i) - v4;
+      const v_float32x4 r2 = dx * dx + dy * dy;
+      const v_float32x4 g = FastExp(r2 * gauss4);
+      const v_float32x4 qx = cv::v_load(basis[0].data() + i), qy = cv::v_load(basis[1].data() + i);
+      const v_float32x4 qxx = cv::v_load(basis[2].data() + i);
+      const v_float32x4 qxy = cv::v_load(basis[3].data() + i);
+      const v_float32x4 qyy = cv::v_load(basis[4].data() + i);
+      v_float32x4 model = b4[0] + b4[1] * qx + b4[2] * qy + b4[3] * qxx + b4[4] * qxy +
+                          b4[5] * qyy + a4 * g;
+      v_float32x4 dxr = zero, dyr = zero, rr2 = zero, gr = zero;
       if constexpr (kReflection) {
-        dxr = q.x - ur;
-        dyr = q.y - vr;
+        dxr = cv::v_load(xs + i) - ur4;
+        dyr = cv::v_load(ys + i) - vr4;
         rr2 = dxr * dxr + dyr * dyr;
-        gr = std::exp(static_cast<float>(-0.5 * rr2 * inv_sr2));
+        gr = FastExp(rr2 * gauss_r4);
+        model = model + ar4 * gr;
+      }
+      const v_float32x4 value = cv::v_load(values + i);
+      // Position weight: below the light (where its reflection lies) the data count less.
+      v_float32x4 sqrt_pw = cv::v_load(valid + i);
+      if (tapered) {
+        const v_float32x4 below = cv::v_max(dy, zero);
+        sqrt_pw = sqrt_pw * FastExp(below * below * taper4);
+      }
+      // A clipped sample the model reaches has no residual.
+      sqrt_pw = cv::v_select((value >= full) & (model >= full), zero, sqrt_pw);
+      const v_float32x4 r = value - model;
+      // Geman-McClure above the model: rho = s^2 z^2 / (2 (1 + z^2)), IRLS weight
+      // 1 / (1 + z^2)^2; plain least squares below it.
+      const v_float32x4 brighter = r > zero;
+      const v_float32x4 z = r * inv_scale4;
+      const v_float32x4 z2 = cv::v_select(brighter, z * z, zero);
+      const v_float32x4 d = one / (one + z2);
+      const v_float32x4 sqrt_w = sqrt_pw * d;
+      const v_float32x4 term =
+          sqrt_pw * sqrt_pw * cv::v_select(brighter, half_scale2_4 * z2 * d, half * r * r);
+      const v_float32x4 wr = sqrt_w * r;
+      cost2 = cost2 + cv::v_cvt_f64(term) + cv::v_cvt_f64_high(term);
+      const v_float32x4 wr2 = wr * wr;
+      wsq2 = wsq2 + cv::v_cvt_f64(wr2) + cv::v_cvt_f64_high(wr2);
+      cv::v_store(wr_out + i, wr);
+      const v_float32x4 ag = sqrt_w * a4 * g * inv_s2_4;
+      cv::v_store(j[0] + i, ag * dx);
+      cv::v_store(j[1] + i, ag * dy);
+      cv::v_store(j[2] + i, ag * r2);
+      cv::v_store(j[3] + i, sqrt_w * g);
+      cv::v_store(j[4] + i, sqrt_w);
+      cv::v_store(j[5] + i, sqrt_w * qx);
+      cv::v_store(j[6] + i, sqrt_w * qy);
+      cv::v_store(j[7] + i, sqrt_w * qxx);
+      cv::v_store(j[8] + i, sqrt_w * qxy);
+      cv::v_store(j[9] + i, sqrt_w * qyy);
+      if constexpr (kReflection) {
+        const v_float32x4 agr = sqrt_w * ar4 * gr * inv_sr2_4;
+        cv::v_store(j[kR] + i, agr * dxr);
+        cv::v_store(j[kR + 1] + i, agr * dyr);
+        cv::v_store(j[kR + 2] + i, agr * rr2);
+        cv::v_store(j[kR + 3] + i, sqrt_w * gr);
+      }
+    }
+    cost = cv::v_reduce_sum(cost2);
+    wsq = cv::v_reduce_sum(wsq2);
+#else
+    for (int i = 0; i < padded; ++i) {
+      const float dx = xs[i] - u, dy = ys[i] - v;
+      const float r2 = dx * dx + dy * dy;
+      const float g = FastExp(r2 * gauss);
+      const float qx = basis[0][i], qy = basis[1][i];
+      const float qxx = basis[2][i], qxy = basis[3][i], qyy = basis[4][i];
+      float model = b[0] + b[1] * qx + b[2] * qy + b[3] * qxx + b[4] * qxy + b[5] * qyy + a * g;
+      float dxr = 0.0f, dyr = 0.0f, rr2 = 0.0f, gr = 0.0f;
+      if constexpr (kReflection) {
+        dxr = xs[i] - ur;
+        dyr = ys[i] - vr;
+        rr2 = dxr * dxr + dyr * dyr;
+        gr = FastExp(rr2 * gauss_r);
         model += ar * gr;
       }
-      if (q.clipped && model >= kFullScale) {
-        weighted_j.row(i).setZero();
-        weighted_r[i] = 0.0f;
-        continue;
+      float sqrt_pw = valid[i];
+      if (tapered) {
+        const float below = std::max(dy, 0.0f);
+        sqrt_pw *= FastExp(below * below * taper_k);
       }
-      const double r = q.value - model;
-      // Position weight: below the light (where its reflection lies) the data count less.
-      double sqrt_position_weight = 1.0;
-      if (taper > 0.0 && dy > 0.0) sqrt_position_weight = std::exp(-0.25 * (dy / taper) * (dy / taper));
-      const double position_weight = sqrt_position_weight * sqrt_position_weight;
-      double sqrt_w = sqrt_position_weight;
-      if (r > 0.0) {
-        // Geman-McClure: rho = s^2 z^2 / (2 (1 + z^2)), IRLS weight 1 / (1 + z^2)^2.
-        const double z2 = (r / scale) * (r / scale);
-        const double d = 1.0 / (1.0 + z2);
-        sqrt_w *= d;
-        cost += position_weight * 0.5 * scale * scale * z2 * d;
-      } else {
-        cost += position_weight * 0.5 * r * r;
-      }
-      wsq += sqrt_w * sqrt_w * r * r;
-      float* j = weighted_j.row(i).data();
-      weighted_r[i] = static_cast<float>(sqrt_w * r);
-      const double ag = sqrt_w * a * g * inv_s2;
-      j[0] = ag * dx;
-      j[1] = ag * dy;
-      j[2] = ag * r2;
-      j[3] = sqrt_w * g;
-      j[4] = sqrt_w;
-      j[5] = sqrt_w * qx;
-      j[6] = sqrt_w * qy;
-      j[7] = sqrt_w * qx * qx;
-      j[8] = sqrt_w * qx * qy;
-      j[9] = sqrt_w * qy * qy;
+      if (values[i] >= kFullScale && model >= kFullScale) sqrt_pw = 0.0f;
+      const float r = values[i] - model;
+      const float z2 = r > 0.0f ? (r * inv_scale) * (r * inv_scale) : 0.0f;
+      const float d = 1.0f / (1.0f + z2);
+      const float sqrt_w = sqrt_pw * d;
+      cost += sqrt_pw * sqrt_pw * (r > 0.0f ? half_scale2 * z2 * d : 0.5f * r * r);
+      const float wr = sqrt_w * r;
+      wsq += wr * wr;
+      wr_out[i] = wr;
+      const float ag = sqrt_w * a * g * inv_s2;
+      j[0][i] = ag * dx;
+      j[1][i] = ag * dy;
+      j[2][i] = ag * r2;
+      j[3][i] = sqrt_w * g;
+      j[4][i] = sqrt_w;
+      j[5][i] = sqrt_w * qx;
+      j[6][i] = sqrt_w * qy;
+      j[7][i] = sqrt_w * qxx;
+      j[8][i] = sqrt_w * qxy;
+      j[9][i] = sqrt_w * qyy;
       if constexpr (kReflection) {
-        const double agr = sqrt_w * ar * gr * inv_sr2;
-        j[kR] = agr * dxr;
-        j[kR + 1] = agr * dyr;
-        j[kR + 2] = agr * rr2;
-        j[kR + 3] = sqrt_w * gr;
+        const float agr = sqrt_w * ar * gr * inv_sr2;
+        j[kR][i] = agr * dxr;
+        j[kR + 1][i] = agr * dyr;
+        j[kR + 2][i] = agr * rr2;
+        j[kR + 3][i] = sqrt_w * gr;
       }
     }
+#endif
     *sum_sq = wsq;
     return cost;
   };
-  // The normal equations of the rows the last evaluate() with the Jacobian wrote.
+  // The normal equations of the columns the last evaluate() with the Jacobian wrote.
   auto normal_equations = [&](Mat* jtj, Vec* jtr) {
     Eigen::Matrix<float, kParams, kParams> h = Eigen::Matrix<float, kParams, kParams>::Zero();
     h.template selfadjointView<Eigen::Lower>().rankUpdate(weighted_j.transpose());
@@ -428,7 +580,7 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
   result.v = theta[1];
   result.sigma = std::exp(theta[2]);
   result.amplitude = theta[3];
-  result.rms = std::sqrt(weighted_sq / samples.size());
+  result.rms = std::sqrt(weighted_sq / num_samples);
   {
     const double qx = (result.u - u0) * inv_s0, qy = (result.v - v0) * inv_s0;
     result.background = theta[4] + theta[5] * qx + theta[6] * qy + theta[7] * qx * qx +
@@ -447,29 +599,41 @@ FitResult FitModel(const std::vector<FitSample>& samples, const FitStart& start,
 }
 
 // Pixels of one channel in [x0, x1] x [y0, y1], subsampled on a grid through (cx, cy) to at
-// most about max_pixels.
-std::vector<FitSample> CollectSamples(const cv::Mat& image, int channel, int cx, int cy, int x0,
-                                      int x1, int y0, int y1, int max_pixels) {
+// most about max_pixels; coordinates relative to (cx, cy).
+FitSamples CollectSamples(const cv::Mat& image, int channel, int cx, int cy, int x0, int x1,
+                          int y0, int y1, int max_pixels) {
   x0 = std::max(0, x0);
   y0 = std::max(0, y0);
   x1 = std::min(image.cols - 1, x1);
   y1 = std::min(image.rows - 1, y1);
-  std::vector<FitSample> samples;
+  FitSamples samples;
+  samples.ox = cx;
+  samples.oy = cy;
   if (x0 > x1 || y0 > y1) return samples;
   const double area = static_cast<double>(x1 - x0 + 1) * (y1 - y0 + 1);
   const int stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(area / max_pixels))));
   const int xs = cx - ((cx - x0) / stride) * stride;
   const int ys = cy - ((cy - y0) / stride) * stride;
   const int channels = image.channels();
-  samples.reserve(static_cast<size_t>(area / (stride * stride)) + 4);
+  const size_t capacity = static_cast<size_t>(area / (stride * stride)) + 4 + kFitLanes;
+  samples.x.reserve(capacity);
+  samples.y.reserve(capacity);
+  samples.value.reserve(capacity);
   for (int y = ys; y <= y1; y += stride) {
     const uint8_t* row = image.ptr<uint8_t>(y);
     for (int x = xs; x <= x1; x += stride) {
-      const int value = row[channels * x + channel];
-      samples.push_back({static_cast<float>(x), static_cast<float>(y), static_cast<float>(value),
-                         value >= kFullScale});
+      samples.x.push_back(static_cast<float>(x - cx));
+      samples.y.push_back(static_cast<float>(y - cy));
+      samples.value.push_back(static_cast<float>(row[channels * x + channel]));
     }
   }
+  samples.count = static_cast<int>(samples.x.size());
+  const int padded = (samples.count + kFitLanes - 1) / kFitLanes * kFitLanes;
+  samples.valid.assign(padded, 0.0f);
+  std::fill(samples.valid.begin(), samples.valid.begin() + samples.count, 1.0f);
+  samples.x.resize(padded, 0.0f);
+  samples.y.resize(padded, 0.0f);
+  samples.value.resize(padded, 0.0f);
   return samples;
 }
 
@@ -482,9 +646,9 @@ FitResult FitLight(const cv::Mat& image, int channel, const FitStart& start, dou
   const int half = static_cast<int>(std::ceil(3.0 * start.sigma)) + 2;
   FitResult result;
   {
-    const std::vector<FitSample> samples = CollectSamples(
-        image, channel, cx, cy, cx - half, cx + half, cy - half, cy + half, max_pixels);
-    if (samples.size() < 12) return result;
+    const FitSamples samples = CollectSamples(image, channel, cx, cy, cx - half, cx + half,
+                                              cy - half, cy + half, max_pixels);
+    if (samples.count < 12) return result;
     // Only a starting point when the reflection model follows.
     result = FitModel<10>(samples, start, noise, taper_sigmas, model_reflection ? 8 : 15);
   }
@@ -499,9 +663,9 @@ FitResult FitLight(const cv::Mat& image, int channel, const FitStart& start, dou
   const int half2 = static_cast<int>(std::ceil(3.0 * refined.sigma)) + 2;
   const int cx2 = static_cast<int>(std::lround(refined.u));
   const int cy2 = static_cast<int>(std::lround(refined.v));
-  const std::vector<FitSample> samples = CollectSamples(
-      image, channel, cx2, cy2, cx2 - side, cx2 + side, cy2 - half2, cy2 + below, max_pixels);
-  if (samples.size() < 20) return result;
+  const FitSamples samples = CollectSamples(image, channel, cx2, cy2, cx2 - side, cx2 + side,
+                                            cy2 - half2, cy2 + below, max_pixels);
+  if (samples.count < 20) return result;
   const FitResult two_component = FitModel<14>(samples, refined, noise, 0.0, 15);
   // The second component must be what it is meant to be: a dimmer blob below the light, not the
   // light itself (the fit can swap the two).
@@ -527,7 +691,7 @@ void CentralDisc(const cv::Mat& image, double u, double v, double sigma,
     const uint8_t* row = image.ptr<uint8_t>(y);
     for (int x = std::max(0, static_cast<int>(std::floor(u - radius)));
          x <= std::min(image.cols - 1, static_cast<int>(std::ceil(u + radius))); ++x) {
-      if (std::hypot(x - u, y - v) > radius) continue;
+      if ((x - u) * (x - u) + (y - v) * (y - v) > radius * radius) continue;
       ++count;
       for (int c = 0; c < channels; ++c) {
         sum[c] += row[channels * x + c];
@@ -554,12 +718,13 @@ double CoreRedRatio(const cv::Mat& image, double u, double v, double sigma) {
   for (int y = y0; y <= y1; ++y) {
     const uint8_t* row = image.ptr<uint8_t>(y);
     for (int x = x0; x <= x1; ++x) {
-      const double d = std::hypot(x - u, y - v);
+      // Squared distances: no hypot per pixel.
+      const double d2 = (x - u) * (x - u) + (y - v) * (y - v);
       const uint8_t* pixel = row + 3 * x;
-      if (d <= core) {
+      if (d2 <= core * core) {
         for (int c = 0; c < 3; ++c) sum[c] += pixel[c];
         ++count;
-      } else if (d >= ring_in && d <= ring_out) {
+      } else if (d2 >= ring_in * ring_in && d2 <= ring_out * ring_out) {
         for (int c = 0; c < 3; ++c) ring[c].push_back(pixel[c]);
       }
     }

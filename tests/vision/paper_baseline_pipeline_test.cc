@@ -81,7 +81,9 @@ TEST(PaperBaselinePipelineTest, CrossbarAlongTheEpipolarLineKeepsItsIdentities) 
   const std::vector<int> truth_left = TrueIds(frame.left.detections, left, scenario.dock, T_D_B);
   const std::vector<int> truth_right = TrueIds(frame.right.detections, right, scenario.dock, T_D_B);
   for (std::size_t i = 0; i < truth_left.size(); ++i) {
-    if (frame.left.light_ids[i] >= 0) EXPECT_EQ(frame.left.light_ids[i], truth_left[i]);
+    if (frame.left.light_ids[i] >= 0) {
+      EXPECT_EQ(frame.left.light_ids[i], truth_left[i]) << "left detection " << i;
+    }
   }
   for (std::size_t i = 0; i < truth_right.size(); ++i) {
     if (frame.right.light_ids[i] >= 0) {

@@ -63,10 +63,11 @@
 // Measured on the simulator (tests/vision/light_detector_test.cc: default run, every 4th frame,
 // 3 cameras, reflections, 3 particles per frame, noise; lights nearer than 8 m, matched within
 // 2 px): clear water recall 1.0, precision 0.997, centroid RMS 0.187 px; turbid water recall
-// 1.0, precision 1.0, RMS 0.198 px. Cost (benchmarks/vision_frontend_benchmark.cc, one core,
-// stereo frame with 6 lights): ~2.6-2.8 ms at 640 x 512, ~6.2-6.9 ms at 1280 x 1024; the Gaussian fits
-// are about 40 % of it (model_reflections = false or coarse_scale = 0 trade accuracy or the last
-// metre for speed). Fewer fit samples cost accuracy (max_fit_pixels 200: turbid RMS 0.27 px),
+// 1.0, precision 1.0, RMS 0.198 px. Cost (benchmarks/vision_frontend_benchmark.cc BM_Detect, one
+// core, stereo frame with 6 lights): ~1.2 ms at 640 x 512, ~3.2 ms at 1280 x 1024; the Gaussian fits
+// (evaluated in float, four samples at a time) are about a third of it on the mono frame with a
+// near light (model_reflections = false or coarse_scale = 0 trade accuracy or the last metre for
+// speed). Fewer fit samples cost accuracy (max_fit_pixels 200: turbid RMS 0.27 px),
 // and so does stopping the fits earlier (turbid RMS 0.21 px, one more false detection per water).
 //
 // Units: pixels and 8-bit gray levels. The sizes that stand for a range (coarse_min_sigma_px,
