@@ -69,6 +69,15 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
     const Eigen::Matrix2d covariance =
         Eigen::Matrix2d::Identity() *
         (obs.sigma_px * obs.sigma_px + options.correlated_pixel_variance);
+    // A light behind the camera at the current estimate cannot be evaluated there (the factor
+    // returns false, and Ceres fails the whole solve at its initial point): the observation
+    // contradicts the prediction and is skipped, as a gate would.
+    const MonoReprojectionFactor check(obs.uv, covariance, rig.mono->intrinsics,
+                                       rig.mono->T_B_C, light->p_D);
+    if (!(check.DepthInCamera(pose) > MonoReprojectionFactor::kMinDepth)) {
+      ++*n_skipped;
+      continue;
+    }
     const ceres::ResidualBlockId id = problem->AddResidualBlock(
         MonoReprojectionFactor::Create(obs.uv, covariance, rig.mono->intrinsics, rig.mono->T_B_C,
                                        light->p_D),

@@ -108,7 +108,9 @@ TEST(SlidingWindowEstimatorTest, SkipsBadMeasurementsAndSaysSo) {
       EXPECT_TRUE(out->T_D_B.p.allFinite());
       EXPECT_TRUE(out->T_D_B.q.coeffs().allFinite());
     }
-    if (k == 20) EXPECT_FALSE(estimator.AddVisionFrame(frame).has_value());  // repeated frame
+    if (k == 20) {
+      EXPECT_FALSE(estimator.AddVisionFrame(frame).has_value());  // repeated frame
+    }
   }
   const EstimatorStats& stats = estimator.stats();
   EXPECT_GT(stats.skipped_imu, 5);

@@ -78,5 +78,51 @@ TEST(VisionFactorsTest, StereoCovarianceIsTakenAtThePredictedLight) {
   }
 }
 
+// A mono light behind the camera at the pose block's value cannot be evaluated there (the factor
+// returns false and Ceres would fail the whole solve): it is skipped and counted, the others
+// are added.
+TEST(VisionFactorsTest, MonoLightBehindTheCameraAtTheEstimateIsSkipped) {
+  const Scenario scenario = test::DefaultScenario();
+  const Calibration calibration = MakeCalibration(scenario);
+  VisionRig rig;
+  rig.mono = calibration.FindCameraByRole(CameraRole::kMono);
+  rig.dock = &scenario.dock;
+  ASSERT_NE(rig.mono, nullptr);
+  // The mono camera 2 m above the dock's first light, looking at it; a second light placed
+  // 1 m above the camera (behind it) by editing a copy of the dock.
+  DockModel dock = scenario.dock;
+  const DockLight& light = dock.lights.front();
+  const Pose3 T_C_D(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.0, 0.0, 2.0) - light.p_D);
+  const Pose3 T_D_B = (rig.mono->T_B_C * T_C_D).Inverse();
+  DockLight behind = dock.lights.back();
+  behind.p_D = T_D_B * (rig.mono->T_B_C * Eigen::Vector3d(0.1, 0.0, -1.0));
+  dock.lights.back() = behind;
+  rig.dock = &dock;
+  double pose[kPoseSize];
+  std::copy(T_D_B.p.data(), T_D_B.p.data() + 3, pose);
+  std::copy(T_D_B.q.coeffs().data(), T_D_B.q.coeffs().data() + 4, pose + 3);
+
+  VisionFrame frame;
+  const Eigen::Vector2d uv = *rig.mono->intrinsics.Project(T_C_D * light.p_D);
+  frame.mono.push_back({light.id, uv, 0.3});
+  frame.mono.push_back({behind.id, uv + Eigen::Vector2d(5.0, 0.0), 0.3});
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  PoseManifold manifold;
+  problem.AddParameterBlock(pose, kPoseSize, &manifold);
+  VisionFactorOptions options;
+  options.use_stereo = false;
+  int skipped = 0;
+  const std::vector<VisionResidual> residuals =
+      AddVisionFactors(&problem, frame, rig, options, pose, &skipped);
+  EXPECT_EQ(residuals.size(), 1u);
+  EXPECT_EQ(skipped, 1);
+  double cost = -1.0;
+  EXPECT_TRUE(problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr,
+                               nullptr));
+  EXPECT_NEAR(cost, 0.0, 1e-12);
+}
+
 }  // namespace
 }  // namespace auvdock

@@ -63,7 +63,8 @@ struct VisionRig {
 };
 
 // Adds the frame's residuals on `pose` (a block already in the problem). Observations with an
-// unknown light id or non-finite values are skipped and counted in *n_skipped.
+// unknown light id or non-finite values, and mono observations of a light behind the camera at
+// the pose block's current value, are skipped and counted in *n_skipped.
 std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const VisionFrame& frame,
                                              const VisionRig& rig,
                                              const VisionFactorOptions& options, double* pose,
