@@ -171,7 +171,8 @@ void PrintTable(const EvaluateOptions& options, const EvaluationReport& report) 
 
   if (!options.decisions_path.empty()) {
     const DecisionAudit& a = report.decisions;
-    std::printf("\ngo/no-go audit (allowed lateral error %.3f m)\n", options.allowed_lateral_error_m);
+    std::printf("\ngo/no-go audit (allowed lateral error %.3f m)\n",
+                options.allowed_lateral_error_m);
     std::printf("  %d GO, %d NO-GO; at GO: max true lateral error %.4f m, max yaw error %.3f deg\n",
                 a.n_go, a.n_no_go, a.max_lateral_error_at_go_m,
                 a.max_yaw_error_at_go_rad * kRadToDeg);

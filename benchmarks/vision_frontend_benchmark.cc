@@ -5,11 +5,11 @@
 //  * BM_PerFrame: the whole per-frame path of the paper's baseline (PaperBaselinePipeline::Process
 //    with dehazing on): dehaze + detect + match (hypothesise-and-verify, MatchRansac) + pose.
 //    Arguments width, height, camera, dehaze (1: on, as the budget counts; 0: the pipeline's
-//    default, see light_detector.h). Camera 0 = the down-looking mono camera at t = 20 s (six lights,
-//    pose by PnP), 1 = the stereo pair at t = 8 s (six lights in each image; two images dehazed
-//    and detected, the left one matched, the right one labelled by prediction, triangulation and
-//    SVD alignment). Counters: the same steps timed one by one on the same frame (thread CPU ms):
-//    dehaze_ms and detect_ms per image, match_pose_ms for the rest
+//    default, see light_detector.h). Camera 0 = the down-looking mono camera at t = 20 s (six
+//    lights, pose by PnP), 1 = the stereo pair at t = 8 s (six lights in each image; two images
+//    dehazed and detected, the left one matched, the right one labelled by prediction,
+//    triangulation and SVD alignment). Counters: the same steps timed one by one on the same frame
+//    (thread CPU ms): dehaze_ms and detect_ms per image, match_pose_ms for the rest
 //    (PaperBaselinePipeline::ProcessDetections).
 // Budget: dehaze + detect + match + pose <= 5 ms per 640 x 512 frame on one core (image decoding
 // not counted). OpenCV runs single-threaded here, as on one core.
@@ -34,7 +34,8 @@ namespace auvdock {
 namespace {
 
 Scenario DefaultScenarioAt(int width, int height) {
-  Scenario scenario = LoadScenario(std::string(AUVDOCK_SOURCE_DIR) + "/data/scenarios/default.yaml");
+  Scenario scenario =
+      LoadScenario(std::string(AUVDOCK_SOURCE_DIR) + "/data/scenarios/default.yaml");
   scenario.cameras.width = width;
   scenario.cameras.height = height;
   return scenario;
@@ -56,7 +57,8 @@ cv::Mat RenderFrame(int width, int height, CameraRole role = CameraRole::kStereo
 
 void BM_Dehaze(benchmark::State& state) {
   cv::setNumThreads(1);
-  const cv::Mat frame = RenderFrame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const cv::Mat frame =
+      RenderFrame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   const DarkChannelDehazer dehazer;  // seed 000: 15 px window, omega 0.5
   for (auto _ : state) {
     DarkChannelDehazer::Result result = dehazer.Dehaze(frame);
@@ -68,7 +70,8 @@ BENCHMARK(BM_Dehaze)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMil
 
 void BM_Detect(benchmark::State& state) {
   cv::setNumThreads(1);
-  const cv::Mat frame = RenderFrame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  const cv::Mat frame =
+      RenderFrame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   const LightDetector detector;  // default options: no dehazing
   size_t lights = 0;
   for (auto _ : state) {

@@ -117,19 +117,22 @@ class ImuPreintegrationFactor final
     using Eigen::Matrix3d;
     using Eigen::Vector3d;
     const Eigen::Map<const Vector3d> p_i(parameters[0]);
-    const Eigen::Quaterniond q_i = Eigen::Map<const Eigen::Quaterniond>(parameters[0] + 3).normalized();
+    const Eigen::Quaterniond q_i =
+        Eigen::Map<const Eigen::Quaterniond>(parameters[0] + 3).normalized();
     const Eigen::Map<const Vector3d> v_i(parameters[1]);
     const Eigen::Map<const Vector3d> bg_i(parameters[2]);
     const Eigen::Map<const Vector3d> ba_i(parameters[2] + 3);
     const Eigen::Map<const Vector3d> p_j(parameters[3]);
-    const Eigen::Quaterniond q_j = Eigen::Map<const Eigen::Quaterniond>(parameters[3] + 3).normalized();
+    const Eigen::Quaterniond q_j =
+        Eigen::Map<const Eigen::Quaterniond>(parameters[3] + 3).normalized();
     const Eigen::Map<const Vector3d> v_j(parameters[4]);
     const Eigen::Map<const Vector3d> bg_j(parameters[5]);
     const Eigen::Map<const Vector3d> ba_j(parameters[5] + 3);
 
     const double dt = preintegration_.sum_dt();
     const CorrectedImuDeltas<double> d = preintegration_.Correct<double>(bg_i, ba_i);
-    const Eigen::Quaterniond dq = preintegration_.delta_q() * QuaternionExp<double>(d.rotation_correction);
+    const Eigen::Quaterniond dq =
+        preintegration_.delta_q() * QuaternionExp<double>(d.rotation_correction);
     const Eigen::Quaterniond error_q = dq.conjugate() * (q_i.conjugate() * q_j);
     const Matrix3d R_i_T = q_i.toRotationMatrix().transpose();
     const Vector3d w_v = v_j - v_i - gravity_D_ * dt;

@@ -33,6 +33,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -138,8 +139,13 @@ class MonoReprojectionFactor {
                                      const PinholeRadtanCamera& camera, const Pose3& T_B_C,
                                      const Eigen::Vector3d& p_D_L,
                                      double information_weight = 1.0) {
+    return Create(std::make_unique<MonoReprojectionFactor>(uv, covariance, camera, T_B_C, p_D_L,
+                                                           information_weight));
+  }
+  // The same for a factor already built (e.g. after checking DepthInCamera).
+  static ceres::CostFunction* Create(std::unique_ptr<MonoReprojectionFactor> factor) {
     return new ceres::AutoDiffCostFunction<MonoReprojectionFactor, kMonoResidualSize, kPoseSize>(
-        new MonoReprojectionFactor(uv, covariance, camera, T_B_C, p_D_L, information_weight));
+        factor.release());
   }
 
   const Eigen::Vector2d& uv() const { return uv_; }

@@ -27,6 +27,8 @@
 #include <Eigen/Geometry>
 #include <ceres/manifold.h>
 
+#include "auvdock/geometry/pose3.h"
+
 namespace auvdock {
 
 inline constexpr int kPoseSize = 7;
@@ -71,6 +73,19 @@ Eigen::Matrix<T, 3, 1> QuaternionLog(const Eigen::Quaternion<T>& q_in) {
   }
   // Near identity: angle / sin(angle / 2) = 2 / w (1 + sin^2 / (6 w^2)) to second order.
   return v * (T(2.0) / q.w() * (T(1.0) + sin_sq / (T(6.0) * q.w() * q.w())));
+}
+
+// The pose a block holds (the quaternion normalised), and a pose written into a block.
+inline Pose3 PoseFromBlock(const double* pose) {
+  return Pose3(Eigen::Map<const Eigen::Quaterniond>(pose + 3).normalized(),
+               Eigen::Map<const Eigen::Vector3d>(pose));
+}
+
+inline void PoseToBlock(const Pose3& T, double* pose) {
+  Eigen::Map<Eigen::Vector3d> p(pose);
+  Eigen::Map<Eigen::Quaterniond> q(pose + 3);
+  p = T.p;
+  q = T.q.normalized();
 }
 
 class PoseManifold final : public ceres::Manifold {

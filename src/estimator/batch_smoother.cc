@@ -50,9 +50,8 @@ void AddInitialPriors(ceres::Problem* problem, const EstimatorOptions& o, BatchS
                                                         o.init_position_sigma_m);
   pose_cov.bottomRightCorner<3, 3>().diagonal().setConstant(o.init_attitude_sigma_rad *
                                                             o.init_attitude_sigma_rad);
-  const Pose3 prior_pose(Eigen::Map<const Eigen::Quaterniond>(s->pose + 3).normalized(),
-                         Eigen::Map<const Eigen::Vector3d>(s->pose));
-  problem->AddResidualBlock(PosePriorFactor::Create(prior_pose, pose_cov), nullptr, s->pose);
+  problem->AddResidualBlock(PosePriorFactor::Create(PoseFromBlock(s->pose), pose_cov), nullptr,
+                            s->pose);
   problem->AddResidualBlock(
       VelocityPriorFactor::Create(Eigen::Vector3d::Zero(),
                                   Eigen::Matrix3d::Identity() * o.init_velocity_sigma_mps *
@@ -198,8 +197,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   for (const auto& s : states) {
     EstimatorOutput out;
     out.t_ns = s->t_ns;
-    out.T_D_B = Pose3(Eigen::Map<const Eigen::Quaterniond>(s->pose + 3).normalized(),
-                      Eigen::Map<const Eigen::Vector3d>(s->pose));
+    out.T_D_B = PoseFromBlock(s->pose);
     out.v_D = Eigen::Map<const Eigen::Vector3d>(s->velocity);
     out.bias.gyro = Eigen::Map<const Eigen::Vector3d>(s->bias);
     out.bias.accel = Eigen::Map<const Eigen::Vector3d>(s->bias + 3);

@@ -24,17 +24,6 @@ constexpr double kNsPerSecond = 1e9;
 
 double Seconds(int64_t ns) { return static_cast<double>(ns) / kNsPerSecond; }
 
-void StorePose(const Pose3& T, double* pose) {
-  std::copy(T.p.data(), T.p.data() + 3, pose);
-  const Eigen::Quaterniond q = T.q.normalized();
-  std::copy(q.coeffs().data(), q.coeffs().data() + 4, pose + 3);
-}
-
-Pose3 LoadPose(const double* pose) {
-  return Pose3(Eigen::Map<const Eigen::Quaterniond>(pose + 3).normalized(),
-               Eigen::Map<const Eigen::Vector3d>(pose));
-}
-
 ImuBias LoadBias(const double* bias) {
   ImuBias b;
   b.gyro = Eigen::Map<const Eigen::Vector3d>(bias);
@@ -122,13 +111,14 @@ bool SlidingWindowEstimator::Initialize(const VisionFrame& frame) {
   if (!frame.T_D_B_initial) return false;
   auto state = std::make_unique<State>();
   state->t_ns = frame.t_ns;
-  StorePose(*frame.T_D_B_initial, state->pose);
+  PoseToBlock(*frame.T_D_B_initial, state->pose);
   problem_->AddParameterBlock(state->pose, kPoseSize, pose_manifold_.get());
   problem_->AddParameterBlock(state->velocity, kVelocitySize);
   problem_->AddParameterBlock(state->bias, kBiasSize);
 
   Matrix6d pose_cov = Matrix6d::Zero();
-  pose_cov.topLeftCorner<3, 3>().diagonal().setConstant(std::pow(options_.init_position_sigma_m, 2));
+  pose_cov.topLeftCorner<3, 3>().diagonal().setConstant(
+      std::pow(options_.init_position_sigma_m, 2));
   pose_cov.bottomRightCorner<3, 3>().diagonal().setConstant(
       std::pow(options_.init_attitude_sigma_rad, 2));
   problem_->AddResidualBlock(PosePriorFactor::Create(*frame.T_D_B_initial, pose_cov), nullptr,
@@ -157,11 +147,12 @@ bool SlidingWindowEstimator::AddState(int64_t t_ns) {
   auto state = std::make_unique<State>();
   state->t_ns = t_ns;
   NavState nav;
-  nav.q_D_B = LoadPose(previous.pose).q;
-  nav.p_D = LoadPose(previous.pose).p;
+  const Pose3 previous_pose = PoseFromBlock(previous.pose);
+  nav.q_D_B = previous_pose.q;
+  nav.p_D = previous_pose.p;
   nav.v_D = Eigen::Map<const Eigen::Vector3d>(previous.velocity);
   const NavState predicted = pim->Predict(nav, bias, dock_.gravity_D);
-  StorePose(Pose3(predicted.q_D_B, predicted.p_D), state->pose);
+  PoseToBlock(Pose3(predicted.q_D_B, predicted.p_D), state->pose);
   Eigen::Map<Eigen::Vector3d>(state->velocity) = predicted.v_D;
   std::copy(previous.bias, previous.bias + kBiasSize, state->bias);
 
@@ -222,7 +213,7 @@ void SlidingWindowEstimator::MarginalizeOldest() {
 EstimatorOutput SlidingWindowEstimator::Output(const State& state) {
   EstimatorOutput out;
   out.t_ns = state.t_ns;
-  out.T_D_B = LoadPose(state.pose);
+  out.T_D_B = PoseFromBlock(state.pose);
   out.v_D = Eigen::Map<const Eigen::Vector3d>(state.velocity);
   out.bias = LoadBias(state.bias);
   for (const VisionResidual& r : state.vision) (r.mono ? out.n_mono : out.n_stereo) += 1;
@@ -292,12 +283,12 @@ std::optional<Pose3> SlidingWindowEstimator::PropagatedPose(int64_t t_ns) const 
   if (window_.empty()) return std::nullopt;
   const State& newest = *window_.back();
   if (t_ns < newest.t_ns) return std::nullopt;
-  if (t_ns == newest.t_ns) return LoadPose(newest.pose);
+  if (t_ns == newest.t_ns) return PoseFromBlock(newest.pose);
   const ImuBias bias = LoadBias(newest.bias);
   const std::optional<ImuPreintegration> pim = imu_.Preintegrate(newest.t_ns, t_ns, bias);
   if (!pim) return std::nullopt;
   NavState nav;
-  const Pose3 T = LoadPose(newest.pose);
+  const Pose3 T = PoseFromBlock(newest.pose);
   nav.q_D_B = T.q;
   nav.p_D = T.p;
   nav.v_D = Eigen::Map<const Eigen::Vector3d>(newest.velocity);

@@ -1,13 +1,16 @@
 #include "auvdock/estimator/vision_factors.h"
 
 #include <cmath>
+#include <memory>
 #include <optional>
+#include <utility>
 
 #include <ceres/loss_function.h>
 
-#include "factors/mono_reprojection_factor.h"
 #include "auvdock/geometry/pose3.h"
 #include "auvdock/vision/stereo_triangulation.h"
+#include "factors/mono_reprojection_factor.h"
+#include "factors/pose_manifold.h"
 #include "factors/stereo_point_factor.h"
 
 namespace auvdock {
@@ -19,13 +22,12 @@ ceres::LossFunction* WeightedHuber(double huber_sigmas, double weight) {
   return new ceres::ScaledLoss(huber, weight, ceres::TAKE_OWNERSHIP);
 }
 
-// The triangulation covariance of a light at its position predicted from the pose block's
-// value: projected into both cameras (noise-free pixels) and propagated as the front-end does.
-std::optional<Eigen::Matrix3d> PredictedStereoCovariance(const VisionRig& rig, const double* pose,
+// The triangulation covariance of a light at its position predicted from the body pose
+// (T_B_D, the inverse of the pose block's value): projected into both cameras (noise-free
+// pixels) and propagated as the front-end does.
+std::optional<Eigen::Matrix3d> PredictedStereoCovariance(const VisionRig& rig, const Pose3& T_B_D,
                                                          const Eigen::Vector3d& p_D) {
-  const Pose3 T_D_B(Eigen::Map<const Eigen::Quaterniond>(pose + 3).normalized(),
-                    Eigen::Map<const Eigen::Vector3d>(pose));
-  const Eigen::Vector3d p_B = T_D_B.Inverse() * p_D;
+  const Eigen::Vector3d p_B = T_B_D * p_D;
   const auto uv_left = rig.stereo_left->intrinsics.Project(rig.stereo_left->T_B_C.Inverse() * p_B);
   const auto uv_right =
       rig.stereo_right->intrinsics.Project(rig.stereo_right->T_B_C.Inverse() * p_B);
@@ -69,20 +71,24 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
     const Eigen::Matrix2d covariance =
         Eigen::Matrix2d::Identity() *
         (obs.sigma_px * obs.sigma_px + options.correlated_pixel_variance);
+    auto factor = std::make_unique<MonoReprojectionFactor>(obs.uv, covariance, rig.mono->intrinsics,
+                                                           rig.mono->T_B_C, light->p_D);
     // A light behind the camera at the current estimate cannot be evaluated there (the factor
     // returns false, and Ceres fails the whole solve at its initial point): the observation
     // contradicts the prediction and is skipped, as a gate would.
-    const MonoReprojectionFactor check(obs.uv, covariance, rig.mono->intrinsics,
-                                       rig.mono->T_B_C, light->p_D);
-    if (!(check.DepthInCamera(pose) > MonoReprojectionFactor::kMinDepth)) {
+    if (!(factor->DepthInCamera(pose) > MonoReprojectionFactor::kMinDepth)) {
       ++*n_skipped;
       continue;
     }
     const ceres::ResidualBlockId id = problem->AddResidualBlock(
-        MonoReprojectionFactor::Create(obs.uv, covariance, rig.mono->intrinsics, rig.mono->T_B_C,
-                                       light->p_D),
+        MonoReprojectionFactor::Create(std::move(factor)),
         WeightedHuber(options.huber_sigmas, weights.mono), pose);
     added.push_back({id, true});
+  }
+  // The body pose the stereo covariances are evaluated at, once per frame.
+  std::optional<Pose3> T_B_D_predicted;
+  if (n_stereo > 0 && options.stereo_covariance_at_prediction && rig.stereo_right != nullptr) {
+    T_B_D_predicted = PoseFromBlock(pose).Inverse();
   }
   for (int i = 0; i < n_stereo; ++i) {
     const StereoLightObservation& obs = frame.stereo[i];
@@ -93,13 +99,14 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
       continue;
     }
     Eigen::Matrix3d covariance = obs.covariance;
-    if (options.stereo_covariance_at_prediction && rig.stereo_right != nullptr) {
-      if (const auto predicted = PredictedStereoCovariance(rig, pose, light->p_D)) {
+    if (T_B_D_predicted) {
+      if (const auto predicted = PredictedStereoCovariance(rig, *T_B_D_predicted, light->p_D)) {
         covariance = *predicted;
       }
     }
     const ceres::ResidualBlockId id = problem->AddResidualBlock(
-        StereoPointFactor::Create(obs.p_S, stereo_scale * covariance, rig.stereo_left->T_B_C, light->p_D),
+        StereoPointFactor::Create(obs.p_S, stereo_scale * covariance, rig.stereo_left->T_B_C,
+                                  light->p_D),
         WeightedHuber(options.huber_sigmas, weights.stereo), pose);
     added.push_back({id, false});
   }

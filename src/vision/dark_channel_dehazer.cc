@@ -251,8 +251,8 @@ DarkChannelDehazer::Result DarkChannelDehazer::Dehaze(const cv::Mat& bgr8) const
   result.dark_channel = MinFilter(ChannelMinimum(bgr8), options_.window);
 
   const double num_pixels = static_cast<double>(rows) * cols;
-  const int count = static_cast<int>(
-      std::clamp(std::lround(options_.top_fraction * num_pixels), 1L, static_cast<long>(num_pixels)));
+  const int count = static_cast<int>(std::clamp(std::lround(options_.top_fraction * num_pixels), 1L,
+                                                static_cast<long>(num_pixels)));
   result.atmospheric_light = AtmosphericLight(bgr8, result.dark_channel, count);
   // A channel with no veiling light at all would divide by zero in eq. 3; one gray level is the
   // smallest value an 8-bit image can show.
@@ -301,7 +301,8 @@ DarkChannelDehazer::Result DarkChannelDehazer::Dehaze(const cv::Mat& bgr8) const
       gray = bgr8;
     }
     gray.convertTo(gray, CV_32F, 1.0 / 255.0);
-    transmission = GuidedFilter(gray, transmission, options_.guided_radius, options_.guided_epsilon);
+    transmission =
+        GuidedFilter(gray, transmission, options_.guided_radius, options_.guided_epsilon);
   }
   const float t_min = static_cast<float>(options_.t_min);
   for (int y = 0; y < rows; ++y) {

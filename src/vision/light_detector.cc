@@ -39,8 +39,9 @@ class CoarseBackground {
     const int w = std::max(1, window_cells);
     const cv::Mat square = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(w, w));
     if (close_cells > 1) {
-      cv::morphologyEx(coarse, coarse, cv::MORPH_CLOSE,
-                       cv::getStructuringElement(cv::MORPH_RECT, cv::Size(close_cells, close_cells)));
+      cv::morphologyEx(
+          coarse, coarse, cv::MORPH_CLOSE,
+          cv::getStructuringElement(cv::MORPH_RECT, cv::Size(close_cells, close_cells)));
     }
     cv::morphologyEx(coarse, coarse, cv::MORPH_OPEN, square);
     cv::blur(coarse, coarse, cv::Size(3, 3), cv::Point(-1, -1), cv::BORDER_REPLICATE);

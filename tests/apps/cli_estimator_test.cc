@@ -98,7 +98,8 @@ TEST_F(EstimatorCli, RunSkipsBadMeasurementsAndCountsThem) {
   const std::string ds = *tmp_ / "bad_ds";
   fs::copy(dataset_, ds, fs::copy_options::recursive);
   std::vector<fs::path> images;
-  for (const auto& entry : fs::directory_iterator(ds + "/cam0/data")) images.push_back(entry.path());
+  for (const auto& entry : fs::directory_iterator(ds + "/cam0/data"))
+    images.push_back(entry.path());
   std::sort(images.begin(), images.end());
   ASSERT_GT(images.size(), 20u);
   test::WriteTextFile(images[15].string(), "not a png");

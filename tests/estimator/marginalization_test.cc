@@ -38,7 +38,8 @@ TEST(MarginalizationTest, PriorEqualsDenseSchurComplementReference) {
   const Eigen::VectorXd b = J.transpose() * r;
   const Eigen::MatrixXd H_mm = H.topLeftCorner(6, 6);
   const Eigen::MatrixXd H_km = H.bottomLeftCorner(9, 6);
-  const Eigen::MatrixXd H_ref = H.bottomRightCorner(9, 9) - H_km * H_mm.inverse() * H_km.transpose();
+  const Eigen::MatrixXd H_ref =
+      H.bottomRightCorner(9, 9) - H_km * H_mm.inverse() * H_km.transpose();
   const Eigen::VectorXd b_ref = b.tail(9) - H_km * H_mm.inverse() * b.head(6);
 
   // The prior's block order is Ceres' (unspecified); the reference follows it.

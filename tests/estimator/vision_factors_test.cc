@@ -1,6 +1,5 @@
 #include "auvdock/estimator/vision_factors.h"
 
-#include <algorithm>
 #include <memory>
 
 #include <ceres/problem.h>
@@ -13,6 +12,20 @@
 
 namespace auvdock {
 namespace {
+
+// A problem holding one pose block on the production manifold.
+struct PoseProblem {
+  explicit PoseProblem(double* pose) : problem(Options()) {
+    problem.AddParameterBlock(pose, kPoseSize, &manifold);
+  }
+  static ceres::Problem::Options Options() {
+    ceres::Problem::Options options;
+    options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    return options;
+  }
+  PoseManifold manifold;
+  ceres::Problem problem;
+};
 
 // A stereo light 9 m ahead, measured 0.4 m nearer than it is (a large depth error at that
 // range). With stereo_covariance_at_prediction the residual is whitened by the triangulation
@@ -33,8 +46,7 @@ TEST(VisionFactorsTest, StereoCovarianceIsTakenAtThePredictedLight) {
   const Pose3 T_S_D(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.1, -0.2, 9.0) - light.p_D);
   const Pose3 T_D_B = (rig.stereo_left->T_B_C * T_S_D).Inverse();
   double pose[kPoseSize];
-  std::copy(T_D_B.p.data(), T_D_B.p.data() + 3, pose);
-  std::copy(T_D_B.q.coeffs().data(), T_D_B.q.coeffs().data() + 4, pose + 3);
+  PoseToBlock(T_D_B, pose);
 
   const Eigen::Vector3d p_S_true = T_S_D * light.p_D;
   const Eigen::Vector3d p_S_measured = p_S_true * (8.6 / p_S_true.z());
@@ -58,20 +70,16 @@ TEST(VisionFactorsTest, StereoCovarianceIsTakenAtThePredictedLight) {
   frame.stereo.push_back({light.id, p_S_measured, at_measured});
   const Eigen::Vector3d e = p_S_measured - p_S_true;
   for (const bool at_prediction : {true, false}) {
-    ceres::Problem::Options problem_options;
-    problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-    ceres::Problem problem(problem_options);
-    PoseManifold manifold;
-    problem.AddParameterBlock(pose, kPoseSize, &manifold);
+    PoseProblem problem(pose);
     VisionFactorOptions options;
     options.use_mono = false;
     options.stereo_covariance_at_prediction = at_prediction;
     int skipped = 0;
     const std::vector<VisionResidual> residuals =
-        AddVisionFactors(&problem, frame, rig, options, pose, &skipped);
+        AddVisionFactors(&problem.problem, frame, rig, options, pose, &skipped);
     ASSERT_EQ(residuals.size(), 1u);
     double cost = 0.0;
-    problem.EvaluateResidualBlock(residuals[0].id, false, &cost, nullptr, nullptr);
+    problem.problem.EvaluateResidualBlock(residuals[0].id, false, &cost, nullptr, nullptr);
     const Eigen::Matrix3d& expected_covariance = at_prediction ? at_truth : at_measured;
     EXPECT_NEAR(2.0 * cost, e.dot(expected_covariance.ldlt().solve(e)),
                 1e-6 * (2.0 * cost)) << at_prediction;
@@ -99,27 +107,22 @@ TEST(VisionFactorsTest, MonoLightBehindTheCameraAtTheEstimateIsSkipped) {
   dock.lights.back() = behind;
   rig.dock = &dock;
   double pose[kPoseSize];
-  std::copy(T_D_B.p.data(), T_D_B.p.data() + 3, pose);
-  std::copy(T_D_B.q.coeffs().data(), T_D_B.q.coeffs().data() + 4, pose + 3);
+  PoseToBlock(T_D_B, pose);
 
   VisionFrame frame;
   const Eigen::Vector2d uv = *rig.mono->intrinsics.Project(T_C_D * light.p_D);
   frame.mono.push_back({light.id, uv, 0.3});
   frame.mono.push_back({behind.id, uv + Eigen::Vector2d(5.0, 0.0), 0.3});
-  ceres::Problem::Options problem_options;
-  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-  ceres::Problem problem(problem_options);
-  PoseManifold manifold;
-  problem.AddParameterBlock(pose, kPoseSize, &manifold);
+  PoseProblem problem(pose);
   VisionFactorOptions options;
   options.use_stereo = false;
   int skipped = 0;
   const std::vector<VisionResidual> residuals =
-      AddVisionFactors(&problem, frame, rig, options, pose, &skipped);
+      AddVisionFactors(&problem.problem, frame, rig, options, pose, &skipped);
   EXPECT_EQ(residuals.size(), 1u);
   EXPECT_EQ(skipped, 1);
   double cost = -1.0;
-  EXPECT_TRUE(problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr,
+  EXPECT_TRUE(problem.problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, nullptr,
                                nullptr));
   EXPECT_NEAR(cost, 0.0, 1e-12);
 }

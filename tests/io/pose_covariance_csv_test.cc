@@ -60,7 +60,8 @@ TEST(PoseCovarianceCsvTest, BadRowsNameTheFileAndLine) {
   Eigen::Matrix<double, 6, 6> asymmetric = SomeCovariance(1.0);
   asymmetric(0, 5) += 0.1;
   WriteRows(path, {{100, SomeCovariance(1.0)}, {200, asymmetric}});
-  EXPECT_THAT(ReadError(path), HasSubstr("covariance.csv: line 3: the covariance is not symmetric"));
+  EXPECT_THAT(ReadError(path),
+              HasSubstr("covariance.csv: line 3: the covariance is not symmetric"));
 
   Eigen::Matrix<double, 6, 6> indefinite = SomeCovariance(1.0);
   indefinite(2, 2) = -1.0;

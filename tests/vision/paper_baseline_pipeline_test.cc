@@ -68,10 +68,12 @@ TEST(PaperBaselinePipelineTest, CrossbarAlongTheEpipolarLineKeepsItsIdentities) 
   const CameraCalibration& left = *pipeline.left_camera();
   const CameraCalibration& right = *pipeline.right_camera();
 
-  const std::vector<LightDetection> left_detections = ProjectLights(
-      left, scenario.dock, T_D_B, {{0, 12.6}, {1, 25.2}, {2, 20.0}, {3, 18.8}, {4, 8.1}, {5, 12.5}});
-  const std::vector<LightDetection> right_detections = ProjectLights(
-      right, scenario.dock, T_D_B, {{0, 11.2}, {1, 10.6}, {2, 12.9}, {3, 9.1}, {4, 9.9}, {5, 20.8}});
+  const std::vector<LightDetection> left_detections =
+      ProjectLights(left, scenario.dock, T_D_B,
+                    {{0, 12.6}, {1, 25.2}, {2, 20.0}, {3, 18.8}, {4, 8.1}, {5, 12.5}});
+  const std::vector<LightDetection> right_detections =
+      ProjectLights(right, scenario.dock, T_D_B,
+                    {{0, 11.2}, {1, 10.6}, {2, 12.9}, {3, 9.1}, {4, 9.9}, {5, 20.8}});
   ASSERT_EQ(left_detections.size(), 6u);
   ASSERT_EQ(right_detections.size(), 6u);
 

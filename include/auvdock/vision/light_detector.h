@@ -23,7 +23,8 @@
 //     rest drops the faint far ones (kOtsu, floored by the same contrast: turbid recall 0.98
 //     instead of 1.0 on the test run); the light pixels are also too few (< 1 %) for a stable
 //     Otsu split.
-//  4. 8-connected components (union-find on the mask's runs), each split by flooding at its significant maxima (rising at least
+//  4. 8-connected components (union-find on the mask's runs), each split by flooding at its
+//  significant maxima (rising at least
 //     min_prominence above the saddle): two lights that touch become two blobs, while the
 //     shoulder of a merged reflection stays with its light.
 //  5. Per blob, the channel to measure in: the unclipped one with the most light, else the one
@@ -64,9 +65,9 @@
 // 3 cameras, reflections, 3 particles per frame, noise; lights nearer than 8 m, matched within
 // 2 px): clear water recall 1.0, precision 0.997, centroid RMS 0.187 px; turbid water recall
 // 1.0, precision 1.0, RMS 0.198 px. Cost (benchmarks/vision_frontend_benchmark.cc BM_Detect, one
-// core, stereo frame with 6 lights): ~1.2 ms at 640 x 512, ~3.2 ms at 1280 x 1024; the Gaussian fits
-// (evaluated in float, four samples at a time) are about a third of it on the mono frame with a
-// near light (model_reflections = false or coarse_scale = 0 trade accuracy or the last metre for
+// core, stereo frame with 6 lights): ~1.2 ms at 640 x 512, ~3.2 ms at 1280 x 1024; the Gaussian
+// fits (evaluated in float, four samples at a time) are about a third of it on the mono frame with
+// a near light (model_reflections = false or coarse_scale = 0 trade accuracy or the last metre for
 // speed). Fewer fit samples cost accuracy (max_fit_pixels 200: turbid RMS 0.27 px),
 // and so does stopping the fits earlier (turbid RMS 0.21 px, one more false detection per water).
 //
