@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   auvdock::cli::AddPnpCommand(app);
   auvdock::cli::AddRunCommand(app);
   auvdock::cli::AddSmoothCommand(app);
+  auvdock::cli::AddDetectCommand(app);
 
   try {
     app.parse(argc, argv);

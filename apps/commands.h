@@ -13,5 +13,6 @@ void AddPnpCommand(CLI::App& root);
 void AddFrontendCommand(CLI::App& root);
 void AddRunCommand(CLI::App& root);
 void AddSmoothCommand(CLI::App& root);
+void AddDetectCommand(CLI::App& root);
 
 }  // namespace auvdock::cli

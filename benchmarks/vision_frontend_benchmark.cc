@@ -2,6 +2,7 @@
 // reflections, particles and noise on), at the rig's 640 x 512 and at 1280 x 1024:
 //  * BM_Dehaze, BM_Detect: dark-channel dehazing (seed 000's enhancement) and guide-light
 //    detection on the stereo-left frame 8 s into the run (all six lights at about 5 m);
+//  * BM_DetectBlob: the real-water detector (BlobLightDetector) on the same frame;
 //  * BM_PerFrame: the whole per-frame path of the paper's baseline (PaperBaselinePipeline::Process
 //    with dehazing on): dehaze + detect + match (hypothesise-and-verify, MatchRansac) + pose.
 //    Arguments width, height, camera, dehaze (1: on, as the budget counts; 0: the pipeline's
@@ -26,6 +27,7 @@
 #include "auvdock/sim/docking_trajectory.h"
 #include "auvdock/sim/scenario.h"
 #include "auvdock/sim/underwater_renderer.h"
+#include "auvdock/vision/blob_light_detector.h"
 #include "auvdock/vision/dark_channel_dehazer.h"
 #include "auvdock/vision/light_detector.h"
 #include "auvdock/vision/paper_baseline_pipeline.h"
@@ -83,6 +85,25 @@ void BM_Detect(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * frame.total());
 }
 BENCHMARK(BM_Detect)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
+
+// The real-water detector (blob_light_detector.h) on the same frame, with the dock's colour.
+void BM_DetectBlob(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const cv::Mat frame =
+      RenderFrame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  BlobLightDetectorOptions options;
+  options.checks.colour = LightColour::kBlueGreen;
+  const BlobLightDetector detector(options);
+  size_t lights = 0;
+  for (auto _ : state) {
+    const std::vector<LightDetection> detections = detector.Detect(frame);
+    lights = detections.size();
+    benchmark::DoNotOptimize(detections.data());
+  }
+  state.counters["lights"] = static_cast<double>(lights);
+  state.SetItemsProcessed(state.iterations() * frame.total());
+}
+BENCHMARK(BM_DetectBlob)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
 
 double ThreadCpuSeconds() {
   timespec now{};

@@ -6,6 +6,7 @@
 
 #include "auvdock/io/yaml_config.h"
 #include "auvdock/io/yaml_writer.h"
+#include "auvdock/vision/light_colour.h"
 
 namespace auvdock {
 
@@ -13,6 +14,12 @@ DockModel LoadDockModel(const std::string& path) {
   const ConfigNode root = ConfigNode::LoadFile(path);
   DockModel dock;
   dock.name = root.GetString("name");
+  dock.light_colour = root.GetString("colour", dock.light_colour);
+  try {
+    ParseLightColour(dock.light_colour);
+  } catch (const std::invalid_argument& e) {
+    root.Fail("colour", e.what());
+  }
   dock.origin_depth_m = root.GetDouble("origin_depth_m", dock.origin_depth_m);
   dock.gravity_D = root.GetVector<3>("gravity_D", dock.gravity_D);
   if (dock.gravity_D.norm() < 9.0 || dock.gravity_D.norm() > 10.5) {
@@ -44,6 +51,7 @@ void SaveDockModel(const DockModel& dock, const std::string& path) {
   YAML::Emitter out;
   out << YAML::BeginMap;
   out << YAML::Key << "name" << YAML::Value << dock.name;
+  out << YAML::Key << "colour" << YAML::Value << dock.light_colour;
   EmitNumber(out, "origin_depth_m", dock.origin_depth_m);
   EmitVector3(out, "gravity_D", dock.gravity_D);
   EmitVector3(out, "beacon_p_D", dock.p_D_beacon);

@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 
+#include "auvdock/geometry/dock_symmetry.h"
 #include "auvdock/vision/hungarian.h"
 #include "auvdock/vision/tracking_matcher.h"
 
@@ -529,8 +530,88 @@ std::string Labels(const Scene& scene, const Hypothesis& h) {
   return out.str();
 }
 
+// The labelling of h with a dock symmetry applied: light permutation[i] takes light i's
+// detection, and the pose becomes T S^-1 (the same pixels: T S^-1 p_perm(i) = T p_i).
+Hypothesis ApplySymmetry(const Hypothesis& h, const DockSymmetry& s) {
+  Hypothesis out = h;
+  for (size_t i = 0; i < h.detection_of_light.size(); ++i) {
+    out.detection_of_light[s.permutation[i]] = h.detection_of_light[i];
+  }
+  out.pose.R = h.pose.R * s.R.transpose();
+  out.pose.t = h.pose.t - out.pose.R * s.t;
+  return out;
+}
+
+// One representative of h's symmetric copies (the lexicographically smallest labelling), so
+// that copies are the same hypothesis, not rivals.
+Hypothesis Canonical(const Hypothesis& h, const std::vector<DockSymmetry>& symmetries) {
+  Hypothesis best = h;
+  for (size_t k = 1; k < symmetries.size(); ++k) {
+    Hypothesis copy = ApplySymmetry(h, symmetries[k]);
+    if (copy.detection_of_light < best.detection_of_light) best = std::move(copy);
+  }
+  return best;
+}
+
 // Spread off the best line below this fraction of the spread along it: collinear.
 constexpr double kCollinearTolerance = 0.05;
+
+// Which of a symmetric dock's equally good poses to report (see SymmetryHint): the index into
+// copies, and in *note how it was chosen.
+size_t ChooseSymmetricCopy(const std::vector<Pose3>& copies, const DockModel& dock,
+                           const std::vector<DockSymmetry>& symmetries, const SymmetryHint& hint,
+                           std::string* note) {
+  constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+  // Angular error (rad) of every copy against the hint; the smallest wins when the next is at
+  // least twice as far (a prediction or gravity a few degrees off, copies tens of degrees apart).
+  auto pick = [&](const std::vector<double>& error, const char* by) -> std::optional<size_t> {
+    std::vector<size_t> order(error.size());
+    for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return error[a] < error[b]; });
+    std::ostringstream s;
+    s.precision(3);
+    if (order.size() < 2 || error[order[1]] >= 2.0 * error[order[0]] + 1e-9) {
+      s << "chosen by " << by << " (" << error[order[0]] * kRadToDeg << " deg off, next "
+        << (order.size() > 1 ? error[order[1]] * kRadToDeg : 0.0) << " deg)";
+      *note = s.str();
+      return order[0];
+    }
+    return std::nullopt;
+  };
+  if (hint.predicted_T_C_D) {
+    std::vector<double> error;
+    for (const Pose3& c : copies) error.push_back(c.q.angularDistance(hint.predicted_T_C_D->q));
+    if (auto k = pick(error, "the prediction")) return *k;
+  }
+  if (hint.gravity_C && hint.gravity_C->norm() > 0.0 && dock.gravity_D.norm() > 0.0) {
+    const Eigen::Vector3d g_C = hint.gravity_C->normalized();
+    std::vector<double> error;
+    for (const Pose3& c : copies) {
+      const double cosine = std::clamp((c.R() * dock.gravity_D.normalized()).dot(g_C), -1.0, 1.0);
+      error.push_back(std::acos(cosine));
+    }
+    if (auto k = pick(error, "gravity")) return *k;
+  }
+  if (hint.approach_direction_D && hint.approach_direction_D->norm() > 0.0) {
+    // The copies' camera centres differ by turns about the symmetry axis (through the lights'
+    // centroid): compare their bearings about that axis with the approach direction's.
+    const Eigen::Vector3d axis = symmetries[1].axis_D;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const DockLight& l : dock.lights) centroid += l.p_D / dock.lights.size();
+    auto across = [&](const Eigen::Vector3d& v) { return Eigen::Vector3d(v - v.dot(axis) * axis); };
+    const Eigen::Vector3d a = across(*hint.approach_direction_D);
+    std::vector<double> error;
+    for (const Pose3& c : copies) {
+      const Eigen::Vector3d b = across(-(c.R().transpose() * c.p) - centroid);
+      const double norms = a.norm() * b.norm();
+      error.push_back(norms > 1e-9 ? std::acos(std::clamp(a.dot(b) / norms, -1.0, 1.0)) : 0.0);
+    }
+    if (auto k = pick(error, "the approach side")) return *k;
+  }
+  *note = "unresolved: no prediction, gravity or approach side tells the copies apart; the "
+          "labels are defined up to the symmetry (the rival poses are listed)";
+  return 0;
+}
 
 struct DetectionTriple {
   std::array<int, 3> index{};
@@ -557,6 +638,13 @@ std::vector<Pose3> SolveP3P(const std::array<Eigen::Vector3d, 3>& bearings_C,
 RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, const DockModel& dock,
                               const PinholeRadtanCamera& camera,
                               const RansacMatcherOptions& options, std::mt19937_64& rng) {
+  return MatchRansac(detections, dock, camera, options, rng, SymmetryHint{});
+}
+
+RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, const DockModel& dock,
+                              const PinholeRadtanCamera& camera,
+                              const RansacMatcherOptions& options, std::mt19937_64& rng,
+                              const SymmetryHint& hint) {
   RansacMatchResult result;
   result.status = MatchStatus::kFailed;
   const int num_lights = static_cast<int>(dock.lights.size());
@@ -577,6 +665,8 @@ RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, con
     return result;
   }
 
+  const std::vector<DockSymmetry> symmetries =
+      FindDockSymmetries(dock, options.symmetry_tolerance_m);
   Scene scene;
   scene.fx = camera.fx();
   scene.fy = camera.fy();
@@ -695,7 +785,7 @@ RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, con
         }
         ++result.num_poses;
         best_inliers = std::max(best_inliers, scored.inliers);
-        if (scored.inliers >= pool_threshold) pool.Offer(scored);
+        if (scored.inliers >= pool_threshold) pool.Offer(Canonical(scored, symmetries));
       }
     }
     if (best_inliers >= explain_all) break;
@@ -706,7 +796,7 @@ RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, con
   const auto& kept = pool.hypotheses();
   for (size_t h = 0; h < kept.size() && static_cast<int>(h) < options.max_refined_hypotheses; ++h) {
     if (kept[h].inliers < kept.front().inliers - 1) break;
-    Hypothesis r = Refine(scene, kept[h], options);
+    Hypothesis r = Canonical(Refine(scene, kept[h], options), symmetries);
     if (!PlausiblePose(scene, r.pose, options)) continue;
     bool duplicate = false;
     for (Hypothesis& other : refined) {
@@ -789,7 +879,20 @@ RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, con
   // Of a planar target's two local minima, report the better pose.
   RigidPose best_pose = best.pose;
   RefinePose(scene, best.detection_of_light, /*try_flip=*/true, &best_pose);
-  const Pose3 T_C_D(Eigen::Quaterniond(best_pose.R), best_pose.t);
+  Pose3 T_C_D(Eigen::Quaterniond(best_pose.R), best_pose.t);
+  if (symmetries.size() > 1) {
+    std::vector<Pose3> copies;
+    for (const DockSymmetry& s : symmetries) {
+      const Eigen::Matrix3d R = best_pose.R * s.R.transpose();
+      copies.emplace_back(Eigen::Quaterniond(R), best_pose.t - R * s.t);
+    }
+    const size_t chosen = ChooseSymmetricCopy(copies, dock, symmetries, hint, &result.symmetry);
+    result.symmetry = DescribeDockSymmetries(symmetries) + " symmetric dock: " + result.symmetry;
+    T_C_D = copies[chosen];
+    for (size_t k = 0; k < copies.size(); ++k) {
+      if (k != chosen) result.symmetric_T_C_D.push_back(copies[k]);
+    }
+  }
   TrackingMatcherOptions tracking;
   tracking.gate_px = options.final_gate_px;
   tracking.min_residual_gate_px = options.final_gate_px;

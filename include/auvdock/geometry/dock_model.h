@@ -27,6 +27,9 @@ struct DockLight {
 struct DockModel {
   std::string name;
   std::vector<DockLight> lights;
+  // Colour of the light the lights add to an image (vision/light_colour.h names: white, blue,
+  // green, blue_green, red); blue-green LEDs are what the seeds' docks carry.
+  std::string light_colour = "blue_green";
   // Deck rectangle, centred on the D origin, used for rendering (the bright platform).
   double deck_length_m = 3.0;  // along x
   double deck_width_m = 2.0;   // along y

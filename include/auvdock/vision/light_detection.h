@@ -4,6 +4,9 @@
 // the centre of the top-left pixel (OpenCV). radius_px: equivalent radius sqrt(area / pi) of
 // the blob above threshold. peak: maximum gray level (0-255) in the blob. score: detection
 // confidence in [0, 1] from the size, shape and brightness checks (1 = a perfect light).
+// covariance: the centre's own 2 x 2 covariance (pixels^2) when the detector measures one (all
+// zero when it does not: the camera's pixel_noise_px then applies). at_border: the light's halo
+// is cut by the image border, which biases its centre.
 #pragma once
 
 #include <string>
@@ -18,6 +21,8 @@ struct LightDetection {
   double radius_px = 0.0;
   double peak = 0.0;
   double score = 0.0;
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  bool at_border = false;
 };
 
 // One detection assigned to one dock light.

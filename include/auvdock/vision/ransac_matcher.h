@@ -37,6 +37,10 @@
 //    pixel_noise_px explains (PoseFitConsistentWithNoise, consistency_alpha), the other local
 //    minimum of a planar target (the deck tilted the other way about the line of sight) is
 //    tried, then the detection whose removal alone explains the misfit is excluded.
+//  * Symmetric docks (dock_symmetry.h): a labelling and its images under the dock's symmetries
+//    explain the image equally well by construction; they are one hypothesis (the pool keeps
+//    one canonical copy), not rivals. The reported copy is chosen by a SymmetryHint; every other
+//    copy's pose is listed in symmetric_T_C_D, and `symmetry` says how the choice was made.
 //  * Decision:
 //      - dock lights collinear -> kAmbiguous (no unique pose; the order along the line reverses);
 //      - fewer than min_inliers (default 4) inliers -> kFailed: three lights always fit a P3P
@@ -74,6 +78,7 @@
 #include <array>
 #include <optional>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -115,6 +120,22 @@ struct RansacMatcherOptions {
   double min_depth_m = 0.05;          // every light at least this far in front of the camera
   int max_refined_hypotheses = 4;
   int max_detection_triples = 400;  // beyond this, a random subset of detection triples
+  // Lights within this of a symmetric layout make the dock symmetric (dock_symmetry.h).
+  double symmetry_tolerance_m = 0.01;
+};
+
+// What is known besides the pixels, to choose among a symmetric dock's equally good poses
+// (T_C_D S^-1 for every symmetry S): in this order, the copy nearest in rotation to a predicted
+// pose (tracking), the copy whose gravity direction R_C_D g_D is nearest to the measured one
+// (gravity_C: from the IMU's attitude, any length), the copy whose camera centre's bearing about
+// the symmetry axis is nearest to that of the approach direction (approach_direction_D, D frame:
+// where the vehicle comes from, seen from the dock). A hint decides only when
+// the next copy is at least twice as far from it as the best; otherwise the next hint is asked,
+// and with none the first copy is reported as "unresolved", all of them listed.
+struct SymmetryHint {
+  std::optional<Pose3> predicted_T_C_D;
+  std::optional<Eigen::Vector3d> gravity_C;
+  std::optional<Eigen::Vector3d> approach_direction_D;
 };
 
 // A MatchResult plus the pose it was verified with (extends MatchResult, so it can be passed
@@ -125,11 +146,19 @@ struct RansacMatchResult : MatchResult {
   int num_triples = 0;         // detection triples tried (cost figure)
   int num_p3p = 0;             // P3P problems solved (cost figure)
   int num_poses = 0;           // poses verified
+  // A symmetric dock (dock_symmetry.h): the other poses that explain the image exactly as well
+  // (T_C_D composed with each non-identity symmetry), and how the reported one was chosen.
+  std::vector<Pose3> symmetric_T_C_D;
+  std::string symmetry;
 };
 
 RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, const DockModel& dock,
                               const PinholeRadtanCamera& camera,
                               const RansacMatcherOptions& options, std::mt19937_64& rng);
+RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, const DockModel& dock,
+                              const PinholeRadtanCamera& camera,
+                              const RansacMatcherOptions& options, std::mt19937_64& rng,
+                              const SymmetryHint& hint);
 
 // The minimal solver on its own: poses T_C_D (up to four) with bearing i (unit, camera frame)
 // pointing at point i (dock frame), all three in front of the camera.

@@ -1,0 +1,325 @@
+// auvdock detect --images "DIR/*.jpg" --calib FILE [--camera NAME] --dock FILE --out DIR
+//                [--overlay] [--labels FILE] [--colour C] [--deinterlace] [--no-tracking]
+//                [--gravity-camera X Y Z]
+//
+// A first look at one's own footage: the real-water light detector (BlobLightDetector), the
+// identification and the mono pose (MonoLightPoser) on every image, in name order. Writes,
+// flushed frame by frame (a stopped run keeps every frame written before the stop):
+//   OUTDIR/detections.csv  frame,image,light_id,u,v,radius,score,cov_uu,cov_uv,cov_vv,at_border
+//                          (light_id -1: not identified; covariance in px^2)
+//   OUTDIR/frames.csv      frame,image,detections,identified,status,tracked,rms_px,sigma_px,
+//                          tx,ty,tz,qx,qy,qz,qw (T_C_D, empty without a pose),symmetry,reason
+//   OUTDIR/camera_poses.tum  T_D_C per frame with a pose, time = frame / rate_hz of the camera
+//   OUTDIR/summary.json    counts, the reasons' counts, time per frame, and with --labels the
+//                          evaluation against the labels (detection_evaluation.h)
+//   OUTDIR/rejected.csv    (--overlay) frame,image,u,v,sigma,reason of every blob candidate
+//                          that failed a check
+//   OUTDIR/overlay/IMAGE.png (--overlay) detections (green: identified, with the id; yellow:
+//                          not identified), rejected candidates (red, with the reason's initial)
+// Bad input (no image matches, an image of another size than calibrated, a grey image where
+// the dock's lights have a colour, unreadable calibration, dock or labels): one line, exit 2.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "apps/commands.h"
+#include "apps/signal_flag.h"
+#include "auvdock/eval/detection_evaluation.h"
+#include "auvdock/io/camera_file.h"
+#include "auvdock/io/csv.h"
+#include "auvdock/io/cancellation.h"
+#include "auvdock/io/dock_io.h"
+#include "auvdock/io/input_error.h"
+#include "auvdock/io/light_labels_csv.h"
+#include "auvdock/io/staged_directory.h"
+#include "auvdock/vision/blob_light_detector.h"
+#include "auvdock/vision/mono_light_poser.h"
+
+namespace fs = std::filesystem;
+
+namespace auvdock::cli {
+namespace {
+
+struct DetectOptions {
+  std::string images;
+  std::string calib;
+  std::string camera;
+  std::string dock;
+  std::string out;
+  std::string labels;
+  std::string colour;
+  bool overlay = false;
+  bool deinterlace = false;
+  bool no_tracking = false;
+  bool quiet = false;
+  std::vector<double> gravity_camera;
+};
+
+using Clock = std::chrono::steady_clock;
+
+// The class of a reason, for counting: its text up to the first number or detail.
+std::string ReasonClass(const std::string& reason) {
+  const size_t end = reason.find_first_of("0123456789{(");
+  std::string key = reason.substr(0, end);
+  while (!key.empty() && (key.back() == ' ' || key.back() == ',')) key.pop_back();
+  return key.empty() ? reason : key;
+}
+
+void DrawOverlay(const cv::Mat& image, const std::vector<LightDetection>& detections,
+                 const std::vector<int>& ids, const std::vector<RejectedLightCandidate>& rejected,
+                 const std::string& path) {
+  cv::Mat vis = image.channels() == 3 ? image.clone() : cv::Mat();
+  if (vis.empty()) cv::cvtColor(image, vis, cv::COLOR_GRAY2BGR);
+  for (const RejectedLightCandidate& r : rejected) {
+    const cv::Point p(cvRound(r.uv.x()), cvRound(r.uv.y()));
+    cv::drawMarker(vis, p, cv::Scalar(0, 0, 255), cv::MARKER_TILTED_CROSS, 6, 1);
+  }
+  for (size_t i = 0; i < detections.size(); ++i) {
+    const LightDetection& d = detections[i];
+    const cv::Point p(cvRound(d.uv.x()), cvRound(d.uv.y()));
+    const bool identified = i < ids.size() && ids[i] >= 0;
+    const cv::Scalar colour = identified ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 255, 255);
+    cv::circle(vis, p, std::max(4, cvRound(d.radius_px * 1.5)), colour, 1, cv::LINE_AA);
+    cv::drawMarker(vis, p, colour, cv::MARKER_CROSS, 5, 1);
+    if (identified) {
+      cv::putText(vis, std::to_string(ids[i]), p + cv::Point(8, -8), cv::FONT_HERSHEY_SIMPLEX, 0.5,
+                  colour, 1, cv::LINE_AA);
+    }
+  }
+  cv::imwrite(path, vis);
+}
+
+void RunDetect(const DetectOptions& options) {
+  std::vector<cv::String> files;
+  try {
+    cv::glob(options.images, files, false);
+  } catch (const cv::Exception&) {
+    files.clear();
+  }
+  std::sort(files.begin(), files.end());
+  if (files.empty()) throw InputError("--images: no file matches '" + options.images + "'");
+  const CameraCalibration camera = LoadCameraCalibration(options.calib, options.camera);
+  const DockModel dock = LoadDockModel(options.dock);
+  LightColour colour;
+  try {
+    colour = ParseLightColour(options.colour.empty() ? dock.light_colour : options.colour);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string("--colour: ") + e.what());
+  }
+  std::optional<LightLabels> labels;
+  if (!options.labels.empty()) labels = LoadLightLabels(options.labels);
+
+  BlobLightDetectorOptions detector_options;
+  detector_options.deinterlace = options.deinterlace;
+  detector_options.checks.colour = colour;
+  const BlobLightDetector detector(detector_options);
+  MonoLightPoserOptions poser_options;
+  poser_options.use_tracking = !options.no_tracking;
+  if (!options.gravity_camera.empty()) {
+    if (options.gravity_camera.size() != 3) {
+      throw InputError("--gravity-camera: expected 3 numbers (x y z in the camera frame)");
+    }
+    const Eigen::Vector3d g(options.gravity_camera[0], options.gravity_camera[1],
+                            options.gravity_camera[2]);
+    if (!(g.norm() > 0.0) || !g.allFinite()) {
+      throw InputError("--gravity-camera: must be a finite, non-zero direction");
+    }
+    poser_options.gravity_C = g;
+  }
+  MonoLightPoser poser(camera, dock, poser_options);
+
+  RequireAbsentOrEmptyDirectory(options.out);
+  fs::create_directories(options.out);
+  if (options.overlay) fs::create_directories(options.out + "/overlay");
+  CsvWriter detections_csv(
+      options.out + "/detections.csv",
+      "frame,image,light_id,u,v,radius,score,cov_uu,cov_uv,cov_vv,at_border");
+  CsvWriter frames_csv(options.out + "/frames.csv",
+                       "frame,image,detections,identified,status,tracked,rms_px,sigma_px,tx,ty,tz,"
+                       "qx,qy,qz,qw,symmetry,reason");
+  CsvWriter rejected_csv;
+  if (options.overlay) {
+    rejected_csv = CsvWriter(options.out + "/rejected.csv", "frame,image,u,v,sigma,reason");
+  }
+  std::ofstream poses(options.out + "/camera_poses.tum");
+  poses << "# timestamp tx ty tz qx qy qz qw (T_D_C: the camera in the dock frame)\n";
+
+  const CancellationToken cancel = InstallSignalCancellation();
+  std::map<std::string, FrameDetections> evaluated;
+  std::map<std::string, int> reasons;
+  int n_frames = 0, n_pose = 0, n_tracked = 0, n_detections = 0, n_no_detection = 0;
+  double detect_s = 0.0, pose_s = 0.0;
+  bool interrupted = false;
+  for (size_t f = 0; f < files.size(); ++f) {
+    if (cancel.IsCancelled()) {
+      interrupted = true;
+      break;
+    }
+    const std::string& path = files[f];
+    const std::string name = fs::path(path).filename().string();
+    cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+    if (image.empty()) throw InputError(path + ": cannot decode the image");
+    if (image.depth() != CV_8U) throw InputError(path + ": not an 8-bit image");
+    if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
+    if (image.cols != camera.intrinsics.width() || image.rows != camera.intrinsics.height()) {
+      throw InputError(path + ": the image is " + std::to_string(image.cols) + "x" +
+                       std::to_string(image.rows) + ", the calibration " +
+                       std::to_string(camera.intrinsics.width()) + "x" +
+                       std::to_string(camera.intrinsics.height()));
+    }
+    if (image.channels() == 1 && colour != LightColour::kWhite) {
+      throw InputError(path + ": a grey image, but the lights are " + LightColourName(colour) +
+                       " (give --colour white to detect without colour)");
+    }
+    const auto t0 = Clock::now();
+    std::vector<RejectedLightCandidate> rejected;
+    const std::vector<LightDetection> detections =
+        detector.Detect(image, options.overlay ? &rejected : nullptr);
+    const auto t1 = Clock::now();
+    const MonoPoseResult pose = poser.Process(detections);
+    const auto t2 = Clock::now();
+    detect_s += std::chrono::duration<double>(t1 - t0).count();
+    pose_s += std::chrono::duration<double>(t2 - t1).count();
+    ++n_frames;
+    n_detections += static_cast<int>(detections.size());
+    if (detections.empty()) ++n_no_detection;
+
+    int identified = 0;
+    for (size_t i = 0; i < detections.size(); ++i) {
+      const LightDetection& d = detections[i];
+      identified += pose.light_ids[i] >= 0;
+      detections_csv.Line(std::to_string(f) + "," + name + "," + std::to_string(pose.light_ids[i]) +
+                          "," + FormatDouble(d.uv.x()) + "," + FormatDouble(d.uv.y()) + "," +
+                          FormatDouble(d.radius_px) + "," + FormatDouble(d.score) + "," +
+                          FormatDouble(d.covariance(0, 0)) + "," + FormatDouble(d.covariance(0, 1)) +
+                          "," + FormatDouble(d.covariance(1, 1)) + "," + (d.at_border ? "1" : "0"));
+    }
+    std::string row = std::to_string(f) + "," + name + "," + std::to_string(detections.size()) +
+                      "," + std::to_string(identified) + "," +
+                      (pose.T_C_D ? "ok" : MatchStatusName(pose.status)) + "," +
+                      (pose.tracked ? "1" : "0") + ",";
+    if (pose.T_C_D) {
+      const Pose3& T = *pose.T_C_D;
+      row += FormatDouble(pose.rms_px) + "," + FormatDouble(pose.pixel_sigma_px) + "," +
+             FormatDouble(T.p.x()) + "," + FormatDouble(T.p.y()) + "," + FormatDouble(T.p.z()) +
+             "," + FormatDouble(T.q.x()) + "," + FormatDouble(T.q.y()) + "," +
+             FormatDouble(T.q.z()) + "," + FormatDouble(T.q.w());
+      const Pose3 T_D_C = T.Inverse();
+      char line[256];
+      std::snprintf(line, sizeof(line), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n",
+                    f / camera.rate_hz, T_D_C.p.x(), T_D_C.p.y(), T_D_C.p.z(), T_D_C.q.x(),
+                    T_D_C.q.y(), T_D_C.q.z(), T_D_C.q.w());
+      poses << line << std::flush;
+      ++n_pose;
+      n_tracked += pose.tracked;
+    } else {
+      row += ",,,,,,,,";
+      ++reasons[ReasonClass(pose.reason)];
+    }
+    std::string reason = pose.reason;
+    std::replace(reason.begin(), reason.end(), ',', ';');
+    std::string symmetry = pose.symmetry_note;
+    std::replace(symmetry.begin(), symmetry.end(), ',', ';');
+    frames_csv.Line(row + "," + symmetry + "," + reason);
+    if (options.overlay) {
+      for (const RejectedLightCandidate& r : rejected) {
+        rejected_csv.Line(std::to_string(f) + "," + name + "," + FormatDouble(r.uv.x()) + "," +
+                          FormatDouble(r.uv.y()) + "," + FormatDouble(r.sigma_px) + "," + r.reason);
+      }
+      DrawOverlay(image, detections, pose.light_ids, rejected,
+                  options.out + "/overlay/" + fs::path(name).stem().string() + ".png");
+    }
+    FrameDetections& e = evaluated[name];
+    for (const LightDetection& d : detections) e.uv.push_back(d.uv);
+    e.has_pose = pose.T_C_D.has_value();
+    if (!options.quiet && n_frames % 25 == 0) {
+      std::fprintf(stderr, "\rdetect: %d/%zu images", n_frames, files.size());
+    }
+  }
+  if (!options.quiet) std::fprintf(stderr, "\n");
+
+  nlohmann::ordered_json summary;
+  summary["images"] = files.size();
+  summary["frames"] = n_frames;
+  summary["interrupted"] = interrupted;
+  summary["frames_with_pose"] = n_pose;
+  summary["frames_tracked"] = n_tracked;
+  summary["frames_without_detection"] = n_no_detection;
+  summary["detections"] = n_detections;
+  summary["colour"] = LightColourName(colour);
+  summary["no_pose_reasons"] = reasons;
+  summary["time_per_frame_ms"] = {{"detect", n_frames ? 1e3 * detect_s / n_frames : 0.0},
+                                  {"identify_and_pose", n_frames ? 1e3 * pose_s / n_frames : 0.0}};
+  std::printf("detect: %d images -> %s: %d with a pose (%d tracked), %d detections\n", n_frames,
+              options.out.c_str(), n_pose, n_tracked, n_detections);
+  for (const auto& [reason, count] : reasons) {
+    std::printf("  no pose: %d x %s\n", count, reason.c_str());
+  }
+  if (labels) {
+    const DetectionEvaluation e = EvaluateDetections(*labels, evaluated);
+    summary["labels"] = {{"file", options.labels},
+                         {"frames", e.frames},
+                         {"frames_not_processed", e.missing_frames},
+                         {"ok_labels", e.ok_labels},
+                         {"recall", e.recall},
+                         {"precision", e.precision},
+                         {"detections", e.detections},
+                         {"centroid_rms_px", e.centroid_rms_px},
+                         {"centroid_median_px", e.centroid_median_px},
+                         {"centroid_samples", e.centroid_samples},
+                         {"pose_frames_eligible", e.pose_frames_eligible},
+                         {"pose_rate", e.pose_rate},
+                         {"missed", e.missed},
+                         {"false_detections", e.false_detections}};
+    std::printf(
+        "  labels: %d frames: recall %.3f (%d/%d ok), precision %.3f, centroid rms %.2f px "
+        "(median %.2f, %d), pose in %d/%d frames with >= 4 ok lights (%.3f)\n",
+        e.frames, e.recall, e.hits, e.ok_labels, e.precision, e.centroid_rms_px,
+        e.centroid_median_px, e.centroid_samples, e.pose_frames, e.pose_frames_eligible,
+        e.pose_rate);
+  }
+  std::ofstream(options.out + "/summary.json") << summary.dump(2) << "\n";
+  if (interrupted) throw Cancelled();
+}
+
+}  // namespace
+
+void AddDetectCommand(CLI::App& root) {
+  auto options = std::make_shared<DetectOptions>();
+  CLI::App* sub = root.add_subcommand(
+      "detect",
+      "Detect and identify the dock's lights in one's own images (mono pose per image); writes "
+      "detections.csv, frames.csv, camera_poses.tum, summary.json [, overlay/]");
+  sub->add_option("--images", options->images, "Image files, a glob pattern: \"DIR/*.jpg\"")
+      ->required();
+  sub->add_option("--calib", options->calib,
+                  "calibration.yaml (auvdock) or an OpenCV FileStorage calibration")
+      ->required();
+  sub->add_option("--camera", options->camera, "Camera name in calibration.yaml");
+  sub->add_option("--dock", options->dock, "dock.yaml: the light layout (and colour)")->required();
+  sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
+  sub->add_option("--labels", options->labels,
+                  "Hand labels (CSV: frame_file,u,v[,status,quality]): measure the detector");
+  sub->add_option("--colour", options->colour,
+                  "Light colour (white, blue, green, blue_green, red); default: the dock's");
+  sub->add_flag("--overlay", options->overlay, "Write each image with the detections drawn");
+  sub->add_flag("--deinterlace", options->deinterlace,
+                "Interlaced video: detect on the even field, line-doubled");
+  sub->add_flag("--no-tracking", options->no_tracking, "Identify every image from scratch");
+  sub->add_option("--gravity-camera", options->gravity_camera,
+                  "Gravity's rough direction in the camera frame (x y z; an upright camera: 0 1 0), "
+                  "to tell a symmetric dock's poses apart")
+      ->expected(3);
+  sub->add_flag("--quiet", options->quiet, "No progress display");
+  sub->callback([options] { RunDetect(*options); });
+}
+
+}  // namespace auvdock::cli

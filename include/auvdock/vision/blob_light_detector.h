@@ -1,0 +1,86 @@
+// Guide-light detector for real water: scale-space blob candidates (blob_candidates.h), the
+// sub-pixel centre of each candidate's core with its own covariance (light_core_centroid.h), and
+// checks on what makes a light, whoever drew the image (light_candidate_checks.h): a compact peak
+// brighter than its halo in every direction, a halo of the dock's light colour, enough contrast.
+//
+// Unlike LightDetector (light_detector.h, tuned to our renderer's look: it rejects the reflection
+// the renderer draws below every light, the renderer's particle colour and dark housings), this
+// detector knows nothing of how a particular renderer draws a scene: extended bright structures
+// (a white funnel, a lit deck, walls) fail the peak and extent checks, differently coloured
+// clutter the colour check. It was developed on real pool footage (a white funnel ringed by blue
+// LEDs) and randomised renders.
+//
+// Pipeline per image: optional field deinterlacing (field_deinterlace.h) -> luma (BT.601) ->
+// candidates -> per candidate: core, evidence, checks -> detections closer than the larger
+// core radius (at least min_separation_px) to a stronger one are the same light, and much weaker
+// ones in a stronger light's halo are its glow (halo_extent_sigmas, max_response_in_halo) -> at most
+// max_detections by score. A detection whose halo ring leaves the image is flagged at_border
+// and its covariance widened by (border_sigma_fraction sigma)^2 per axis: the cut biases the
+// centroid by a fraction of the light's size.
+//
+// Score in [0, 1]: the geometric mean of response / (2 candidates.min_response) and halo_excess /
+// (2 min_halo_excess) (1 for white lights), each clamped to [0, 1].
+//
+// Units: pixels (0, 0 is the centre of the top-left pixel), gray levels. Detect() is const and
+// thread-safe.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "auvdock/vision/blob_candidates.h"
+#include "auvdock/vision/light_candidate_checks.h"
+#include "auvdock/vision/light_core_centroid.h"
+#include "auvdock/vision/light_detection.h"
+
+namespace auvdock {
+
+struct BlobLightDetectorOptions {
+  bool deinterlace = false;  // keep the even field, rebuild odd rows (combing)
+  // Scale-normalised LoG response of at least 30 gray levels: a light of ~60 levels of contrast
+  // at its own scale.
+  BlobCandidateOptions candidates{/*min_sigma_px=*/1.5, /*max_sigma_px=*/13.5, /*num_scales=*/7,
+                                  /*min_response=*/30.0};
+  LightCoreOptions core;
+  LightCandidateCheckOptions checks;
+  double min_separation_px = 3.0;
+  // A candidate within halo_extent_sigmas sigma of a kept light whose response is less than
+  // max_response_in_halo of that light's lies in its glow: bloom, a fitting or rim the light
+  // illuminates, a reflection. Two real lights that close in the image are about equally bright.
+  double halo_extent_sigmas = 3.5;
+  double max_response_in_halo = 0.5;
+  double border_sigma_fraction = 0.5;
+  int max_detections = 64;
+};
+
+// A candidate that was not kept, and why (for overlays and "why no light" reports).
+struct RejectedLightCandidate {
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();
+  double sigma_px = 0.0;
+  std::string reason;
+};
+
+class BlobLightDetector {
+ public:
+  // Throws std::invalid_argument for options out of range.
+  explicit BlobLightDetector(const BlobLightDetectorOptions& options = {});
+
+  // Lights in an 8-bit BGR (CV_8UC3) or gray (CV_8UC1) image, by descending score; a gray image
+  // has no colour and skips the colour check. rejected (optional) receives every candidate not
+  // kept. Throws std::invalid_argument for an empty image or another type.
+  std::vector<LightDetection> Detect(const cv::Mat& image,
+                                     std::vector<RejectedLightCandidate>* rejected = nullptr) const;
+
+  const BlobLightDetectorOptions& options() const { return options_; }
+
+ private:
+  BlobLightDetectorOptions options_;
+};
+
+// Robust per-pixel noise sigma of a CV_32FC1 image (gray levels): from the median absolute
+// difference of horizontal neighbours on every 4th row, sigma = MAD / (0.6745 sqrt(2)).
+double EstimatePixelNoise(const cv::Mat& luma);
+
+}  // namespace auvdock

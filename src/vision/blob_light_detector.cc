@@ -1,0 +1,133 @@
+#include "auvdock/vision/blob_light_detector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+#include "auvdock/vision/field_deinterlace.h"
+
+namespace auvdock {
+namespace {
+
+double Clamp01(double v) { return std::clamp(v, 0.0, 1.0); }
+
+}  // namespace
+
+double EstimatePixelNoise(const cv::Mat& luma) {
+  std::vector<float> diffs;
+  diffs.reserve(static_cast<size_t>(luma.rows / 4 + 1) * luma.cols);
+  for (int y = 0; y < luma.rows; y += 4) {
+    const float* row = luma.ptr<float>(y);
+    for (int x = 1; x < luma.cols; ++x) diffs.push_back(std::abs(row[x] - row[x - 1]));
+  }
+  if (diffs.empty()) return 1.0;
+  std::nth_element(diffs.begin(), diffs.begin() + diffs.size() / 2, diffs.end());
+  return std::max(0.5, diffs[diffs.size() / 2] / (0.6745 * std::sqrt(2.0)));
+}
+
+BlobLightDetector::BlobLightDetector(const BlobLightDetectorOptions& options) : options_(options) {
+  const auto& c = options.core;
+  if (!(c.core_level > 0.0 && c.core_level < 1.0) || !(c.window_sigmas > 0.0) ||
+      !(c.floor_percentile >= 0.0 && c.floor_percentile < 1.0) || !(c.shape_fraction >= 0.0) ||
+      !(c.floor_px >= 0.0) || !(options.min_separation_px >= 0.0) ||
+      !(options.border_sigma_fraction >= 0.0) || options.max_detections < 1 ||
+      !(options.halo_extent_sigmas >= 0.0) || !(options.max_response_in_halo >= 0.0) ||
+      !(options.checks.halo_radius_sigmas > 0.0)) {
+    throw std::invalid_argument("BlobLightDetectorOptions out of range");
+  }
+  FindBlobCandidates(cv::Mat::zeros(16, 16, CV_32F), options.candidates);  // checks its options
+}
+
+std::vector<LightDetection> BlobLightDetector::Detect(
+    const cv::Mat& image, std::vector<RejectedLightCandidate>* rejected) const {
+  if (image.empty() || (image.type() != CV_8UC3 && image.type() != CV_8UC1)) {
+    throw std::invalid_argument("BlobLightDetector: expected a non-empty CV_8UC3 or CV_8UC1 image");
+  }
+  const cv::Mat source = options_.deinterlace ? LineDoubleEvenField(image) : image;
+  cv::Mat luma;
+  if (source.channels() == 3) {
+    cv::cvtColor(source, luma, cv::COLOR_BGR2GRAY);
+  } else {
+    luma = source;
+  }
+  luma.convertTo(luma, CV_32F);
+  const double noise = EstimatePixelNoise(luma);
+  const bool has_colour = source.channels() == 3;
+  const double background_excess = MedianColourExcess(source, options_.checks.colour);
+
+  struct Kept {
+    LightDetection detection;
+    double sigma;
+    double response;
+  };
+  std::vector<Kept> kept;
+  const LightCandidateCheckOptions& checks = options_.checks;
+  for (const BlobCandidate& candidate : FindBlobCandidates(luma, options_.candidates)) {
+    auto reject = [&](const Eigen::Vector2d& uv, const std::string& reason) {
+      if (rejected) rejected->push_back({uv, candidate.sigma_px, reason});
+    };
+    const Eigen::Vector2d at(candidate.x, candidate.y);
+    const auto core =
+        MeasureLightCore(luma, candidate.x, candidate.y, candidate.sigma_px, noise, options_.core);
+    if (!core) {
+      reject(at, "no contrast");
+      continue;
+    }
+    const LightCandidateEvidence evidence =
+        MeasureCandidateEvidence(source, luma, *core, candidate.sigma_px, background_excess,
+                                 options_.checks);
+    const std::string reason =
+        CheckLightCandidate(candidate, *core, evidence, has_colour, checks);
+    if (!reason.empty()) {
+      reject(core->uv, reason);
+      continue;
+    }
+    std::string overlap;
+    for (const Kept& k : kept) {
+      const double distance = (k.detection.uv - core->uv).norm();
+      const double separation =
+          std::max({options_.min_separation_px, k.detection.radius_px, core->radius_px});
+      if (distance < separation) {
+        overlap = "duplicate";
+        break;
+      }
+      if (distance < options_.halo_extent_sigmas * k.sigma &&
+          candidate.response < options_.max_response_in_halo * k.response) {
+        overlap = "in the halo of a brighter light";
+        break;
+      }
+    }
+    if (!overlap.empty()) {
+      reject(core->uv, overlap);
+      continue;
+    }
+    LightDetection d;
+    d.uv = core->uv;
+    d.radius_px = std::max(core->radius_px, candidate.sigma_px);
+    d.peak = core->peak;
+    const double strength = Clamp01(candidate.response / (2.0 * options_.candidates.min_response));
+    const double colour = has_colour && options_.checks.colour != LightColour::kWhite
+                              ? Clamp01(evidence.halo_excess / (2.0 * options_.checks.min_halo_excess))
+                              : 1.0;
+    d.score = std::sqrt(strength * colour);
+    d.covariance = core->covariance;
+    d.at_border = evidence.at_border;
+    if (d.at_border) {
+      const double s = options_.border_sigma_fraction * candidate.sigma_px;
+      d.covariance += s * s * Eigen::Matrix2d::Identity();
+    }
+    kept.push_back({d, candidate.sigma_px, candidate.response});
+  }
+  std::vector<LightDetection> out;
+  out.reserve(kept.size());
+  for (const Kept& k : kept) out.push_back(k.detection);
+  std::stable_sort(out.begin(), out.end(), [](const LightDetection& a, const LightDetection& b) {
+    return a.score > b.score;
+  });
+  if (static_cast<int>(out.size()) > options_.max_detections) out.resize(options_.max_detections);
+  return out;
+}
+
+}  // namespace auvdock

@@ -1,0 +1,98 @@
+#include "auvdock/vision/light_candidate_checks.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace auvdock {
+namespace {
+
+constexpr int kRingSamples = 24;
+constexpr int kHaloRings = 3;
+constexpr int kSectors = 8;
+constexpr double kPi = 3.14159265358979323846;
+
+}  // namespace
+
+LightCandidateEvidence MeasureCandidateEvidence(const cv::Mat& bgr, const cv::Mat& luma,
+                                                const LightCore& core, double sigma_px,
+                                                double background_excess,
+                                                const LightCandidateCheckOptions& options) {
+  LightCandidateEvidence evidence;
+  const bool colour_image = bgr.type() == CV_8UC3;
+  const double outer = std::max(options.halo_radius_sigmas * sigma_px, options.min_halo_radius_px);
+  // The peak test on the outer ring; the colour on rings from just outside the core to it (a
+  // halo's colour is strongest next to the white core, and fades into the background).
+  evidence.halo_excess = -std::numeric_limits<double>::infinity();
+  const double inner = std::min(outer, std::max(core.radius_px + 1.0, 0.5 * outer));
+  for (int ring = 0; ring < kHaloRings; ++ring) {
+    const double rho = inner + (outer - inner) * ring / (kHaloRings - 1.0);
+    std::array<double, kSectors> sector_luma{};
+    std::array<int, kSectors> sector_count{};
+    double excess_sum = 0.0;
+    int excess_count = 0;
+    for (int s = 0; s < kRingSamples; ++s) {
+      const double angle = 2.0 * kPi * s / kRingSamples;
+      const int px = static_cast<int>(std::lround(core.uv.x() + rho * std::cos(angle)));
+      const int py = static_cast<int>(std::lround(core.uv.y() + rho * std::sin(angle)));
+      if (px < 0 || py < 0 || px >= luma.cols || py >= luma.rows) {
+        evidence.at_border = true;
+        continue;
+      }
+      const int sector = s * kSectors / kRingSamples;
+      sector_luma[sector] += luma.at<float>(py, px);
+      ++sector_count[sector];
+      if (colour_image) {
+        const cv::Vec3b& p = bgr.at<cv::Vec3b>(py, px);
+        excess_sum += ColourExcess(options.colour, p[0], p[1], p[2]);
+        ++excess_count;
+      }
+    }
+    if (excess_count > 0) {
+      evidence.halo_excess =
+          std::max(evidence.halo_excess, excess_sum / excess_count - background_excess);
+    }
+    if (ring == kHaloRings - 1) {
+      double brightest = -1.0;
+      for (int k = 0; k < kSectors; ++k) {
+        if (sector_count[k] > 0) brightest = std::max(brightest, sector_luma[k] / sector_count[k]);
+      }
+      evidence.peak_drop = brightest < 0.0 ? 0.0 : core.peak - brightest;
+    }
+  }
+  if (!std::isfinite(evidence.halo_excess)) evidence.halo_excess = 0.0;
+  return evidence;
+}
+
+double MedianColourExcess(const cv::Mat& bgr, LightColour colour) {
+  if (bgr.type() != CV_8UC3 || colour == LightColour::kWhite) return 0.0;
+  std::vector<float> values;
+  values.reserve(static_cast<size_t>(bgr.rows / 4 + 1) * (bgr.cols / 4 + 1));
+  for (int y = 0; y < bgr.rows; y += 4) {
+    const cv::Vec3b* row = bgr.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < bgr.cols; x += 4) {
+      values.push_back(static_cast<float>(ColourExcess(colour, row[x][0], row[x][1], row[x][2])));
+    }
+  }
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore& core,
+                                const LightCandidateEvidence& evidence, bool has_colour,
+                                const LightCandidateCheckOptions& options) {
+  if (core.touches_window || core.radius_px > options.max_core_radius_sigmas * candidate.sigma_px) {
+    return "extended";
+  }
+  if (core.touches_border) return "cut by the border";
+  if (evidence.peak_drop < options.min_peak_drop) return "not a peak";
+  if (has_colour && options.colour != LightColour::kWhite &&
+      evidence.halo_excess < options.min_halo_excess) {
+    return "wrong colour";
+  }
+  return {};
+}
+
+}  // namespace auvdock

@@ -1,0 +1,108 @@
+#include "auvdock/vision/mono_light_poser.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "auvdock/vision/pnp_solver.h"
+
+namespace auvdock {
+
+MonoLightPoser::MonoLightPoser(const CameraCalibration& camera, const DockModel& dock,
+                               const MonoLightPoserOptions& options)
+    : camera_(camera), dock_(dock), options_(options), rng_(options.seed) {}
+
+MonoPoseResult MonoLightPoser::Process(const std::vector<LightDetection>& detections) {
+  MonoPoseResult result;
+  result.light_ids.assign(detections.size(), -1);
+  ++frames_since_pose_;
+
+  // The noise the detections claim (their own covariances), never below the camera's.
+  double trace_sum = 0.0;
+  int measured = 0;
+  for (const LightDetection& d : detections) {
+    if (d.covariance.trace() > 0.0) {
+      trace_sum += d.covariance.trace();
+      ++measured;
+    }
+  }
+  double sigma = camera_.pixel_noise_px;
+  if (measured > 0) sigma = std::max(sigma, std::sqrt(trace_sum / measured / 2.0));
+  result.pixel_sigma_px = sigma;
+
+  if (static_cast<int>(detections.size()) < options_.min_lights) {
+    result.reason = "only " + std::to_string(detections.size()) + " detections (need " +
+                    std::to_string(options_.min_lights) + ")";
+    return result;
+  }
+
+  MatchResult match;
+  std::optional<Pose3> start;
+  if (options_.use_tracking && last_T_C_D_ && frames_since_pose_ <= options_.max_gap_frames) {
+    TrackingMatcherOptions tracking = options_.tracking;
+    tracking.gate_px = options_.tracking_gate_px;
+    tracking.pixel_noise_px = sigma;
+    tracking.final_gate_px = std::max(tracking.final_gate_px, 6.0 * sigma);
+    tracking.min_matches = options_.min_lights;
+    match = MatchByPrediction(detections, dock_, camera_.intrinsics, *last_T_C_D_, tracking);
+    if (match.status == MatchStatus::kOk) {
+      result.tracked = true;
+      start = last_T_C_D_;
+    }
+  }
+  if (!result.tracked) {
+    RansacMatcherOptions ransac = options_.ransac;
+    ransac.pixel_noise_px = sigma;
+    ransac.final_gate_px = std::max(ransac.final_gate_px, 6.0 * sigma);
+    ransac.hypothesis_gate_px = std::max(ransac.hypothesis_gate_px, 10.0 * sigma);
+    ransac.min_inliers = options_.min_lights;
+    SymmetryHint hint;
+    if (last_T_C_D_) hint.predicted_T_C_D = last_T_C_D_;
+    hint.gravity_C = options_.gravity_C;
+    const RansacMatchResult r =
+        MatchRansac(detections, dock_, camera_.intrinsics, ransac, rng_, hint);
+    match = r;
+    start = r.T_C_D;
+    result.symmetric_T_C_D = r.symmetric_T_C_D;
+    result.symmetry_note = r.symmetry;
+  }
+  result.status = match.status;
+  if (match.status != MatchStatus::kOk) {
+    result.reason = std::string(MatchStatusName(match.status)) + ": " + match.reason;
+    return result;
+  }
+
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<int> ids(detections.size(), -1);
+  for (const LightMatch& m : match.matches) {
+    const DockLight* light = dock_.FindLight(m.light_id);
+    if (!light || m.detection < 0 || m.detection >= static_cast<int>(detections.size())) continue;
+    ids[m.detection] = m.light_id;
+    points.push_back(light->p_D);
+    pixels.push_back(detections[m.detection].uv);
+  }
+  PnpOptions pnp;
+  pnp.pixel_sigma = sigma;
+  const PnpResult pose = SolvePnp(points, pixels, camera_.intrinsics, pnp, start);
+  if (!pose.ok) {
+    result.status = MatchStatus::kFailed;
+    result.reason = "pnp: " + pose.reason;
+    return result;
+  }
+  result.light_ids = ids;
+  result.T_C_D = pose.T_C_D;
+  result.rms_px = pose.rms_px;
+  result.num_lights = static_cast<int>(points.size());
+  result.covariance_local = pose.covariance_local;
+  const int dof = 2 * result.num_lights - 6;
+  if (dof > 0) {
+    const double s02 = pose.rms_px * pose.rms_px * result.num_lights / (sigma * sigma * dof);
+    if (s02 > 1.0) result.covariance_local *= s02;
+  }
+  last_T_C_D_ = pose.T_C_D;
+  frames_since_pose_ = 0;
+  return result;
+}
+
+}  // namespace auvdock

@@ -1,0 +1,270 @@
+// BlobLightDetector on scenes drawn here, independently of the simulator's renderer: blue LEDs
+// (a saturated white core in a bright blue halo, as close LEDs bloom in the real pool footage:
+// b - r of the halo ~100-170 gray levels 5-10 px from the core) beside a large white-green funnel, white spots, a
+// yellow-green textured wall, JPEG compression; and its parts (candidates, core centroid).
+#include "auvdock/vision/blob_light_detector.h"
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "auvdock/vision/field_deinterlace.h"
+
+namespace auvdock {
+namespace {
+
+struct Led {
+  Eigen::Vector2d uv;
+  double core_px;  // radius of the saturated core
+  double halo_px;  // sigma of the blue halo
+};
+
+// BGR float image, values 0-255 before clipping.
+void AddLed(const Led& led, cv::Mat* image) {
+  const int r = static_cast<int>(std::ceil(4 * led.halo_px + led.core_px));
+  for (int y = std::max(0, int(led.uv.y()) - r); y < std::min(image->rows, int(led.uv.y()) + r); ++y) {
+    for (int x = std::max(0, int(led.uv.x()) - r); x < std::min(image->cols, int(led.uv.x()) + r);
+         ++x) {
+      // 4 x 4 supersampling of the core disc, so that its centroid is the true centre.
+      double core = 0.0;
+      for (int sy = 0; sy < 4; ++sy) {
+        for (int sx = 0; sx < 4; ++sx) {
+          const double dx = x - 0.375 + 0.25 * sx - led.uv.x();
+          const double dy = y - 0.375 + 0.25 * sy - led.uv.y();
+          core += (dx * dx + dy * dy <= led.core_px * led.core_px) / 16.0;
+        }
+      }
+      const double d2 = (x - led.uv.x()) * (x - led.uv.x()) + (y - led.uv.y()) * (y - led.uv.y());
+      const double halo = std::exp(-0.5 * d2 / (led.halo_px * led.halo_px));
+      cv::Vec3f& p = image->at<cv::Vec3f>(y, x);
+      p += cv::Vec3f(320.0f, 170.0f, 50.0f) * static_cast<float>(halo) +
+           cv::Vec3f(400.0f, 400.0f, 400.0f) * static_cast<float>(core);
+    }
+  }
+}
+
+struct Scene {
+  cv::Mat bgr;
+  std::vector<Led> leds;
+};
+
+Scene MakeScene(uint64_t seed, bool jpeg) {
+  std::mt19937_64 rng(seed);
+  Scene scene;
+  cv::Mat image(480, 640, CV_32FC3);
+  cv::Mat texture(480 / 8, 640 / 8, CV_32F);
+  cv::randn(texture, 0.0, 12.0);
+  cv::resize(texture, texture, image.size(), 0, 0, cv::INTER_CUBIC);
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      const float t = texture.at<float>(y, x);
+      const float shade = 0.6f + 0.4f * static_cast<float>(y) / image.rows;
+      image.at<cv::Vec3f>(y, x) = cv::Vec3f(30.0f + t, 95.0f + t, 90.0f + t) * shade;
+    }
+  }
+  // A white-green funnel interior, partly saturated, with dark vanes.
+  cv::ellipse(image, cv::Point(330, 250), cv::Size(120, 100), 0, 0, 360,
+              cv::Scalar(150, 225, 180), cv::FILLED);
+  cv::ellipse(image, cv::Point(330, 290), cv::Size(90, 45), 0, 0, 360, cv::Scalar(255, 255, 250),
+              cv::FILLED);
+  cv::line(image, cv::Point(330, 150), cv::Point(330, 350), cv::Scalar(40, 40, 40), 9);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 2.0);
+  // White specks (fittings, marine snow) that are not lights.
+  std::uniform_real_distribution<double> ux(20, 620), uy(20, 460);
+  for (int k = 0; k < 6; ++k) {
+    cv::circle(image, cv::Point(int(ux(rng)), int(uy(rng))), 2, cv::Scalar(220, 235, 235),
+               cv::FILLED);
+  }
+  // Eight LEDs round the funnel, one of them touching its bright rim.
+  std::uniform_real_distribution<double> jitter(-0.5, 0.5), size(0.8, 1.3);
+  for (int k = 0; k < 8; ++k) {
+    const double a = 2.0 * 3.14159265358979 * (k + 0.5) / 8.0;
+    const double radius = k == 2 ? 118.0 : 150.0;
+    Led led{Eigen::Vector2d(330 + radius * 1.1 * std::cos(a) + jitter(rng),
+                            250 + radius * std::sin(a) + jitter(rng)),
+            3.0 * size(rng), 7.0 * size(rng)};
+    AddLed(led, &image);
+    scene.leds.push_back(led);
+  }
+  cv::Mat noise(image.size(), CV_32FC3);
+  cv::randn(noise, 0.0, 2.0);
+  image += noise;
+  image.convertTo(scene.bgr, CV_8UC3);
+  if (jpeg) {
+    std::vector<uchar> buffer;
+    cv::imencode(".jpg", scene.bgr, buffer, {cv::IMWRITE_JPEG_QUALITY, 85});
+    scene.bgr = cv::imdecode(buffer, cv::IMREAD_COLOR);
+  }
+  return scene;
+}
+
+BlobLightDetectorOptions BlueOptions() {
+  BlobLightDetectorOptions o;
+  o.checks.colour = LightColour::kBlue;
+  return o;
+}
+
+void ExpectAllLedsAndNothingElse(const Scene& scene, const std::vector<LightDetection>& found,
+                                 double max_error_px) {
+  std::vector<char> used(found.size(), 0);
+  for (const Led& led : scene.leds) {
+    int best = -1;
+    for (size_t j = 0; j < found.size(); ++j) {
+      if (!used[j] && (best < 0 || (found[j].uv - led.uv).norm() < (found[best].uv - led.uv).norm())) {
+        best = static_cast<int>(j);
+      }
+    }
+    ASSERT_GE(best, 0) << "LED at " << led.uv.transpose() << " not found";
+    EXPECT_LT((found[best].uv - led.uv).norm(), max_error_px) << "LED at " << led.uv.transpose();
+    used[best] = 1;
+  }
+  for (size_t j = 0; j < found.size(); ++j) {
+    EXPECT_TRUE(used[j]) << "false detection at " << found[j].uv.transpose();
+  }
+}
+
+TEST(BlobLightDetector, FindsLedsAmongWhiteStructures) {
+  for (uint64_t seed = 1; seed <= 5; ++seed) {
+    const Scene scene = MakeScene(seed, false);
+    const BlobLightDetector detector(BlueOptions());
+    ExpectAllLedsAndNothingElse(scene, detector.Detect(scene.bgr), 0.5);
+  }
+}
+
+TEST(BlobLightDetector, SurvivesJpegCompression) {
+  const Scene scene = MakeScene(3, true);
+  const BlobLightDetector detector(BlueOptions());
+  ExpectAllLedsAndNothingElse(scene, detector.Detect(scene.bgr), 0.6);
+}
+
+TEST(BlobLightDetector, TheColourCheckIsWhatRejectsWhiteClutter) {
+  // Told the lights are white, the white funnel patches and specks pass as lights as well.
+  const Scene scene = MakeScene(1, false);
+  BlobLightDetectorOptions white = BlueOptions();
+  white.checks.colour = LightColour::kWhite;
+  const auto as_white = BlobLightDetector(white).Detect(scene.bgr);
+  const auto as_blue = BlobLightDetector(BlueOptions()).Detect(scene.bgr);
+  EXPECT_EQ(as_blue.size(), scene.leds.size());
+  EXPECT_GT(as_white.size(), as_blue.size());
+}
+
+TEST(BlobLightDetector, EachDetectionCarriesACovariance) {
+  const Scene scene = MakeScene(2, false);
+  for (const LightDetection& d : BlobLightDetector(BlueOptions()).Detect(scene.bgr)) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(d.covariance);
+    EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
+    EXPECT_LT(std::sqrt(eig.eigenvalues().maxCoeff()), 2.0);  // px: a compact core
+    EXPECT_GT(d.score, 0.0);
+    EXPECT_LE(d.score, 1.0);
+  }
+}
+
+TEST(BlobLightDetector, LightCutByTheBorderIsFlaggedAndWidened) {
+  cv::Mat image(200, 200, CV_32FC3, cv::Scalar(30, 90, 90));
+  AddLed({Eigen::Vector2d(100, 100), 3.0, 7.0}, &image);
+  AddLed({Eigen::Vector2d(192, 60), 3.0, 7.0}, &image);  // halo cut, core inside
+  AddLed({Eigen::Vector2d(198, 140), 3.0, 7.0}, &image);  // core cut: not used
+  cv::Mat bgr;
+  image.convertTo(bgr, CV_8UC3);
+  const auto found = BlobLightDetector(BlueOptions()).Detect(bgr);
+  ASSERT_EQ(found.size(), 2u);
+  const LightDetection& inner = found[0].uv.x() < 150 ? found[0] : found[1];
+  const LightDetection& cut = found[0].uv.x() < 150 ? found[1] : found[0];
+  EXPECT_FALSE(inner.at_border);
+  EXPECT_TRUE(cut.at_border);
+  EXPECT_GT(cut.covariance.trace(), 4.0 * inner.covariance.trace());
+}
+
+TEST(BlobLightDetector, GreyImageSkipsTheColourCheck) {
+  const Scene scene = MakeScene(4, false);
+  cv::Mat grey;
+  cv::cvtColor(scene.bgr, grey, cv::COLOR_BGR2GRAY);
+  const auto found = BlobLightDetector(BlueOptions()).Detect(grey);
+  int leds = 0;
+  for (const Led& led : scene.leds) {
+    for (const LightDetection& d : found) leds += (d.uv - led.uv).norm() < 1.0;
+  }
+  EXPECT_EQ(leds, static_cast<int>(scene.leds.size()));
+}
+
+TEST(BlobLightDetector, RejectedCandidatesSayWhy) {
+  const Scene scene = MakeScene(1, false);
+  std::vector<RejectedLightCandidate> rejected;
+  BlobLightDetector(BlueOptions()).Detect(scene.bgr, &rejected);
+  ASSERT_FALSE(rejected.empty());
+  int wrong_colour = 0;
+  for (const auto& r : rejected) {
+    EXPECT_FALSE(r.reason.empty());
+    wrong_colour += r.reason == "wrong colour";
+  }
+  EXPECT_GT(wrong_colour, 0);
+}
+
+TEST(BlobLightDetector, InterlacedCombingIsUndone) {
+  // A moving LED in interlaced video: the odd field sees it 4 px to the right. On the even
+  // field, line-doubled, the centre is the even field's; on the raw frame it lies in between.
+  cv::Mat even(240, 320, CV_32FC3, cv::Scalar(30, 90, 90)), odd = even.clone();
+  AddLed({Eigen::Vector2d(150.0, 120.0), 3.0, 7.0}, &even);
+  AddLed({Eigen::Vector2d(154.0, 120.0), 3.0, 7.0}, &odd);
+  cv::Mat frame = even.clone();
+  for (int y = 1; y < frame.rows; y += 2) odd.row(y).copyTo(frame.row(y));
+  cv::Mat bgr;
+  frame.convertTo(bgr, CV_8UC3);
+  BlobLightDetectorOptions o = BlueOptions();
+  o.deinterlace = true;
+  const auto fielded = BlobLightDetector(o).Detect(bgr);
+  ASSERT_EQ(fielded.size(), 1u);
+  EXPECT_NEAR(fielded[0].uv.x(), 150.0, 0.3);
+  EXPECT_NEAR(fielded[0].uv.y(), 120.0, 0.5);
+}
+
+TEST(LineDoubleEvenField, KeepsEvenRowsAndInterpolatesOdd) {
+  cv::Mat image(5, 3, CV_8UC1);
+  for (int y = 0; y < 5; ++y) image.row(y).setTo(10 * y * y);
+  const cv::Mat out = LineDoubleEvenField(image);
+  EXPECT_EQ(out.at<uint8_t>(0, 0), 0);
+  EXPECT_EQ(out.at<uint8_t>(1, 1), 20);  // (0 + 40) / 2
+  EXPECT_EQ(out.at<uint8_t>(2, 2), 40);
+  EXPECT_EQ(out.at<uint8_t>(3, 0), 100);  // (40 + 160) / 2
+  EXPECT_EQ(out.at<uint8_t>(4, 0), 160);
+}
+
+TEST(BlobCandidates, ScaleOfAGaussianBlobIsItsSize) {
+  for (const double s : {2.0, 4.0, 8.0}) {
+    cv::Mat image(160, 160, CV_32F, cv::Scalar(20));
+    for (int y = 0; y < 160; ++y) {
+      for (int x = 0; x < 160; ++x) {
+        const double d2 = (x - 80.0) * (x - 80.0) + (y - 80.0) * (y - 80.0);
+        image.at<float>(y, x) += 100.0f * static_cast<float>(std::exp(-0.5 * d2 / (s * s)));
+      }
+    }
+    BlobCandidateOptions o;
+    o.num_scales = 13;
+    o.max_sigma_px = 16.0;
+    o.min_sigma_px = 1.0;
+    const auto found = FindBlobCandidates(image, o);
+    ASSERT_FALSE(found.empty());
+    EXPECT_EQ(found[0].x, 80);
+    EXPECT_EQ(found[0].y, 80);
+    EXPECT_NEAR(found[0].sigma_px / s, 1.0, 0.2) << s;
+    EXPECT_NEAR(found[0].response, 50.0, 10.0) << s;  // half the amplitude, at every size
+  }
+}
+
+TEST(BlobLightDetector, BadInputThrows) {
+  EXPECT_THROW(BlobLightDetector().Detect(cv::Mat()), std::invalid_argument);
+  EXPECT_THROW(BlobLightDetector().Detect(cv::Mat(10, 10, CV_32FC3)), std::invalid_argument);
+  BlobLightDetectorOptions o;
+  o.core.core_level = 1.5;
+  EXPECT_THROW(BlobLightDetector{o}, std::invalid_argument);
+  o = {};
+  o.candidates.num_scales = 0;
+  EXPECT_THROW(BlobLightDetector{o}, std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace auvdock
