@@ -1,9 +1,10 @@
 // auvdock detect --images "DIR/*.jpg" --calib FILE [--camera NAME] --dock FILE --out DIR
 //                [--overlay] [--labels FILE] [--colour C] [--deinterlace] [--no-tracking]
-//                [--gravity-camera X Y Z]
+//                [--gravity-camera X Y Z] [--min-halo-excess GRAY]
 //
 // A first look at one's own footage: the real-water light detector (BlobLightDetector), the
-// identification and the mono pose (MonoLightPoser) on every image, in name order. Writes,
+// identification and the mono pose (MonoLightPoser) on every image, in name order; the halo
+// colour threshold is learned from the identified lights (HaloColourLearner) unless given. Writes,
 // flushed frame by frame (a stopped run keeps every frame written before the stop):
 //   OUTDIR/detections.csv  frame,image,light_id,u,v,radius,score,cov_uu,cov_uv,cov_vv,at_border
 //                          (light_id -1: not identified; covariance in px^2)
@@ -41,6 +42,7 @@
 #include "auvdock/io/light_labels_csv.h"
 #include "auvdock/io/staged_directory.h"
 #include "auvdock/vision/blob_light_detector.h"
+#include "auvdock/vision/halo_colour_learner.h"
 #include "auvdock/vision/mono_light_poser.h"
 
 namespace fs = std::filesystem;
@@ -61,6 +63,7 @@ struct DetectOptions {
   bool no_tracking = false;
   bool quiet = false;
   std::vector<double> gravity_camera;
+  double min_halo_excess = -1.0;  // < 0: learned from the identified lights
 };
 
 using Clock = std::chrono::steady_clock;
@@ -120,7 +123,10 @@ void RunDetect(const DetectOptions& options) {
   BlobLightDetectorOptions detector_options;
   detector_options.deinterlace = options.deinterlace;
   detector_options.checks.colour = colour;
+  if (options.min_halo_excess >= 0.0) detector_options.checks.min_halo_excess = options.min_halo_excess;
   const BlobLightDetector detector(detector_options);
+  HaloColourLearner colour_learner(detector_options.checks.min_halo_excess);
+  const bool learn_colour = options.min_halo_excess < 0.0;
   MonoLightPoserOptions poser_options;
   poser_options.use_tracking = !options.no_tracking;
   if (!options.gravity_camera.empty()) {
@@ -182,7 +188,7 @@ void RunDetect(const DetectOptions& options) {
     const auto t0 = Clock::now();
     std::vector<RejectedLightCandidate> rejected;
     const std::vector<LightDetection> detections =
-        detector.Detect(image, options.overlay ? &rejected : nullptr);
+        detector.Detect(image, options.overlay ? &rejected : nullptr, colour_learner.threshold());
     const auto t1 = Clock::now();
     const MonoPoseResult pose = poser.Process(detections);
     const auto t2 = Clock::now();
@@ -218,6 +224,7 @@ void RunDetect(const DetectOptions& options) {
                     f / camera.rate_hz, T_D_C.p.x(), T_D_C.p.y(), T_D_C.p.z(), T_D_C.q.x(),
                     T_D_C.q.y(), T_D_C.q.z(), T_D_C.q.w());
       poses << line << std::flush;
+      if (learn_colour) colour_learner.Observe(detections, pose.light_ids);
       ++n_pose;
       n_tracked += pose.tracked;
     } else {
@@ -256,6 +263,10 @@ void RunDetect(const DetectOptions& options) {
   summary["detections"] = n_detections;
   summary["colour"] = LightColourName(colour);
   summary["no_pose_reasons"] = reasons;
+  summary["halo_colour"] = {
+      {"learned", colour_learner.learned()},
+      {"threshold", colour_learner.threshold()},
+      {"identified_median", colour_learner.median_excess() ? *colour_learner.median_excess() : 0.0}};
   summary["time_per_frame_ms"] = {{"detect", n_frames ? 1e3 * detect_s / n_frames : 0.0},
                                   {"identify_and_pose", n_frames ? 1e3 * pose_s / n_frames : 0.0}};
   std::printf("detect: %d images -> %s: %d with a pose (%d tracked), %d detections\n", n_frames,
@@ -314,6 +325,9 @@ void AddDetectCommand(CLI::App& root) {
   sub->add_flag("--deinterlace", options->deinterlace,
                 "Interlaced video: detect on the even field, line-doubled");
   sub->add_flag("--no-tracking", options->no_tracking, "Identify every image from scratch");
+  sub->add_option("--min-halo-excess", options->min_halo_excess,
+                  "Fixed halo-colour threshold (gray levels); default: start permissive and learn "
+                  "it from the identified lights");
   sub->add_option("--gravity-camera", options->gravity_camera,
                   "Gravity's rough direction in the camera frame (x y z; an upright camera: 0 1 0), "
                   "to tell a symmetric dock's poses apart")

@@ -37,6 +37,8 @@ std::vector<BlobCandidate> FindBlobCandidates(const cv::Mat& luma,
   if (luma.empty() || (luma.type() != CV_32FC1 && luma.type() != CV_8UC1)) {
     throw std::invalid_argument("FindBlobCandidates: expected a non-empty CV_32FC1 or CV_8UC1");
   }
+  // Float throughout: the 8-bit fixed-point blurs are no faster here (more instructions per
+  // pixel on this OpenCV) and their quantisation makes spurious maxima.
   cv::Mat level0;
   luma.convertTo(level0, CV_32F);
 
@@ -64,9 +66,13 @@ std::vector<BlobCandidate> FindBlobCandidates(const cv::Mat& luma,
     return level;
   };
 
+  // Responses at each scale's own pyramid level (level pixel j is full-resolution pixel
+  // 2^level j: pyrDown's kernel is centred on the even pixels).
   std::vector<cv::Mat> responses(n);
+  std::vector<int> levels(n);
   for (int k = 0; k < n; ++k) {
     const int level = level_for(sigmas[k]);
+    levels[k] = level;
     while (static_cast<int>(pyramid.size()) <= level) {
       cv::Mat down;
       cv::pyrDown(pyramid.back(), down);
@@ -83,44 +89,45 @@ std::vector<BlobCandidate> FindBlobCandidates(const cv::Mat& luma,
     } else {
       blurred = pyramid[level];
     }
-    cv::Mat laplacian;
-    cv::Laplacian(blurred, laplacian, CV_32F, 1, 1.0, 0.0, cv::BORDER_REPLICATE);
     // Laplacian per level pixel^2 -> per full-resolution pixel^2: divide by pixel^2.
-    const double scale = -sigmas[k] * sigmas[k] / (pixel * pixel);
-    if (level == 0) {
-      responses[k] = laplacian * scale;
-    } else {
-      // pyrDown puts level pixel j at full-resolution pixel pixel * j (its kernel is centred on
-      // the even pixels), so full pixel x samples the level at x / pixel. cv::resize would
-      // sample it at (x + 0.5) / pixel - 0.5 and shift every response by (pixel - 1) / 2 px.
-      const cv::Matx23d full_to_level(1.0 / pixel, 0.0, 0.0, 0.0, 1.0 / pixel, 0.0);
-      cv::Mat up;
-      cv::warpAffine(laplacian, up, full_to_level, level0.size(),
-                     cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
-      responses[k] = up * scale;
-    }
+    cv::Laplacian(blurred, responses[k], CV_32F, 1, -sigmas[k] * sigmas[k] / (pixel * pixel), 0.0,
+                  cv::BORDER_REPLICATE);
   }
+  // Response of scale k at a full-resolution point, bilinear on its level.
+  auto sample = [&](int k, double x, double y) {
+    const cv::Mat& r = responses[k];
+    const double pixel = std::pow(2.0, levels[k]);
+    const double gx = std::clamp(x / pixel, 0.0, r.cols - 1.0);
+    const double gy = std::clamp(y / pixel, 0.0, r.rows - 1.0);
+    const int x0 = std::min(static_cast<int>(gx), r.cols - 2 < 0 ? 0 : r.cols - 2);
+    const int y0 = std::min(static_cast<int>(gy), r.rows - 2 < 0 ? 0 : r.rows - 2);
+    const int x1 = std::min(x0 + 1, r.cols - 1), y1 = std::min(y0 + 1, r.rows - 1);
+    const double ax = gx - x0, ay = gy - y0;
+    return (1 - ay) * ((1 - ax) * r.at<float>(y0, x0) + ax * r.at<float>(y0, x1)) +
+           ay * ((1 - ax) * r.at<float>(y1, x0) + ax * r.at<float>(y1, x1));
+  };
 
-  // Maxima over the 3 x 3 neighbourhood in space, then over the neighbouring scales.
-  std::vector<cv::Mat> spatial_max(n);
-  const cv::Mat kernel = cv::Mat::ones(3, 3, CV_8U);
-  for (int k = 0; k < n; ++k) cv::dilate(responses[k], spatial_max[k], kernel);
-
+  // Maxima over the 3 x 3 neighbourhood on the scale's own grid, then not below the neighbouring
+  // scales at the same point (sampled on their grids).
   std::vector<BlobCandidate> found;
   const float threshold = static_cast<float>(options.min_response);
+  const cv::Mat kernel = cv::Mat::ones(3, 3, CV_8U);
+  cv::Mat spatial_max;
   for (int k = 0; k < n; ++k) {
     const cv::Mat& r = responses[k];
+    cv::dilate(r, spatial_max, kernel);
+    const int pixel = 1 << levels[k];
     for (int y = 0; y < r.rows; ++y) {
       const float* row = r.ptr<float>(y);
-      const float* own = spatial_max[k].ptr<float>(y);
-      const float* below = k > 0 ? spatial_max[k - 1].ptr<float>(y) : nullptr;
-      const float* above = k + 1 < n ? spatial_max[k + 1].ptr<float>(y) : nullptr;
+      const float* own = spatial_max.ptr<float>(y);
       for (int x = 0; x < r.cols; ++x) {
         const float v = row[x];
         if (v < threshold || v < own[x]) continue;
-        if (below && v < below[x]) continue;
-        if (above && v < above[x]) continue;
-        found.push_back({x, y, sigmas[k], v});
+        const int fx = std::min(x * pixel, level0.cols - 1);
+        const int fy = std::min(y * pixel, level0.rows - 1);
+        if (k > 0 && v < sample(k - 1, fx, fy)) continue;
+        if (k + 1 < n && v < sample(k + 1, fx, fy)) continue;
+        found.push_back({fx, fy, sigmas[k], v});
       }
     }
   }

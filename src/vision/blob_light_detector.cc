@@ -41,7 +41,8 @@ BlobLightDetector::BlobLightDetector(const BlobLightDetectorOptions& options) : 
 }
 
 std::vector<LightDetection> BlobLightDetector::Detect(
-    const cv::Mat& image, std::vector<RejectedLightCandidate>* rejected) const {
+    const cv::Mat& image, std::vector<RejectedLightCandidate>* rejected,
+    std::optional<double> min_halo_excess) const {
   if (image.empty() || (image.type() != CV_8UC3 && image.type() != CV_8UC1)) {
     throw std::invalid_argument("BlobLightDetector: expected a non-empty CV_8UC3 or CV_8UC1 image");
   }
@@ -63,7 +64,8 @@ std::vector<LightDetection> BlobLightDetector::Detect(
     double response;
   };
   std::vector<Kept> kept;
-  const LightCandidateCheckOptions& checks = options_.checks;
+  LightCandidateCheckOptions checks = options_.checks;
+  if (min_halo_excess) checks.min_halo_excess = *min_halo_excess;
   for (const BlobCandidate& candidate : FindBlobCandidates(luma, options_.candidates)) {
     auto reject = [&](const Eigen::Vector2d& uv, const std::string& reason) {
       if (rejected) rejected->push_back({uv, candidate.sigma_px, reason});
@@ -109,11 +111,12 @@ std::vector<LightDetection> BlobLightDetector::Detect(
     d.peak = core->peak;
     const double strength = Clamp01(candidate.response / (2.0 * options_.candidates.min_response));
     const double colour = has_colour && options_.checks.colour != LightColour::kWhite
-                              ? Clamp01(evidence.halo_excess / (2.0 * options_.checks.min_halo_excess))
+                              ? Clamp01(evidence.halo_excess / (2.0 * checks.min_halo_excess))
                               : 1.0;
     d.score = std::sqrt(strength * colour);
     d.covariance = core->covariance;
     d.at_border = evidence.at_border;
+    d.colour_excess = evidence.halo_excess;
     if (d.at_border) {
       const double s = options_.border_sigma_fraction * candidate.sigma_px;
       d.covariance += s * s * Eigen::Matrix2d::Identity();

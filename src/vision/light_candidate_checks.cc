@@ -90,7 +90,8 @@ std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore&
   if (evidence.peak_drop < options.min_peak_drop) return "not a peak";
   if (has_colour && options.colour != LightColour::kWhite &&
       evidence.halo_excess < options.min_halo_excess) {
-    return "wrong colour";
+    return "wrong colour (halo excess " + std::to_string(std::lround(evidence.halo_excess)) +
+           "; need " + std::to_string(std::lround(options.min_halo_excess)) + ")";
   }
   return {};
 }

@@ -25,6 +25,7 @@
 // thread-safe.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -70,8 +71,11 @@ class BlobLightDetector {
   // Lights in an 8-bit BGR (CV_8UC3) or gray (CV_8UC1) image, by descending score; a gray image
   // has no colour and skips the colour check. rejected (optional) receives every candidate not
   // kept. Throws std::invalid_argument for an empty image or another type.
+  // min_halo_excess, when given, replaces checks.min_halo_excess for this image (a threshold
+  // learned from the footage: halo_colour_learner.h).
   std::vector<LightDetection> Detect(const cv::Mat& image,
-                                     std::vector<RejectedLightCandidate>* rejected = nullptr) const;
+                                     std::vector<RejectedLightCandidate>* rejected = nullptr,
+                                     std::optional<double> min_halo_excess = std::nullopt) const;
 
   const BlobLightDetectorOptions& options() const { return options_; }
 

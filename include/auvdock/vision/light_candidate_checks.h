@@ -28,9 +28,12 @@ struct LightCandidateCheckOptions {
   LightColour colour = LightColour::kBlue;
   double halo_radius_sigmas = 2.0;
   double min_halo_radius_px = 3.0;
-  // Mean colour excess on the halo ring, gray levels; not applied for white lights. A blue LED's
-  // halo in clear water is ~100-170 (b - r), a white surface ~0, a yellow-green wall ~-60.
-  double min_halo_excess = 100.0;
+  // Colour excess of the halo (the most coloured of rings from just outside the core to
+  // halo_radius_sigmas sigma) against the image's median, gray levels; not applied for white
+  // lights. Permissive: lights in our renders reach ~50-95, blue LEDs blooming in a pool
+  // ~120-190, white and grey clutter stays below ~35; a footage's own value is learned from its
+  // identified lights (halo_colour_learner.h).
+  double min_halo_excess = 40.0;
   double min_peak_drop = 1.0;       // gray levels
   double max_core_radius_sigmas = 2.0;  // a core wider than this is a bright surface
 };

@@ -6,7 +6,8 @@
 // confidence in [0, 1] from the size, shape and brightness checks (1 = a perfect light).
 // covariance: the centre's own 2 x 2 covariance (pixels^2) when the detector measures one (all
 // zero when it does not: the camera's pixel_noise_px then applies). at_border: the light's halo
-// is cut by the image border, which biases its centre.
+// is cut by the image border, which biases its centre. colour_excess: how strongly the halo shows
+// the light's colour against the image's median, gray levels (0 when not measured).
 #pragma once
 
 #include <string>
@@ -23,6 +24,7 @@ struct LightDetection {
   double score = 0.0;
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   bool at_border = false;
+  double colour_excess = 0.0;
 };
 
 // One detection assigned to one dock light.
