@@ -1,5 +1,5 @@
 // auvdock frontend --dataset DIR --out OUTDIR [--dehaze] [--no-tracking]
-//                  [--matcher ransac|omnidirectional]
+//                  [--matcher ransac|omnidirectional] [--detector contrast|blob]
 //
 // Runs the paper's per-frame pipeline (PaperBaselinePipeline) over every camera frame and
 // writes, flushed frame by frame (a stopped run keeps every frame written before the stop):
@@ -7,7 +7,9 @@
 //                               not identified)
 //   OUTDIR/per_frame.tum        the fused body pose T_D_B (TUM), frames with a pose only
 //   OUTDIR/per_frame_stereo.tum the stereo (SVD) pose alone; per_frame_mono.tum the PnP pose
-//   OUTDIR/stages.csv           timestamp_ns,stage,n_<camera>... (identified lights per camera)
+//   OUTDIR/stages.csv           timestamp_ns,stage,n_<camera>... (identified lights per camera),
+//                               reason (why there is no pose: the frame's and each camera's)
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -39,6 +41,7 @@ struct FrontendOptions {
   bool dehaze = false;
   bool no_tracking = false;
   std::string matcher = "ransac";
+  std::string detector = "contrast";
   bool quiet = false;
 };
 
@@ -73,6 +76,11 @@ void RunFrontend(const FrontendOptions& options) {
   PaperBaselineOptions pipeline_options;
   pipeline_options.detector.dehaze = options.dehaze;
   pipeline_options.use_tracking = !options.no_tracking;
+  if (options.detector == "blob") {
+    pipeline_options.detector_kind = LightDetectorKind::kBlob;
+  } else if (options.detector != "contrast") {
+    throw InputError("--detector: expected contrast or blob (got '" + options.detector + "')");
+  }
   if (options.matcher == "omnidirectional") {
     pipeline_options.matcher = BaselineMatcher::kOmnidirectional;
   } else if (options.matcher != "ransac") {
@@ -102,7 +110,9 @@ void RunFrontend(const FrontendOptions& options) {
   for (const auto* cam : cameras) {
     if (cam) stage_header += ",n_" + cam->name;
   }
+  stage_header += ",reason";
   CsvWriter stages(options.out + "/stages.csv", stage_header);
+  std::map<std::string, int> no_pose_reasons;
   TumWriter fused(options.out + "/per_frame.tum");
   TumWriter stereo(options.out + "/per_frame_stereo.tum");
   TumWriter mono(options.out + "/per_frame_mono.tum");
@@ -141,7 +151,15 @@ void RunFrontend(const FrontendOptions& options) {
       }
       stage_row += "," + std::to_string(obs.num_identified());
     }
-    stages.Line(stage_row);
+    // Why there is no pose (empty with one); commas would split the column.
+    std::string reason = frame.T_D_B ? std::string() : frame.reason;
+    for (int c = 0; c < 3 && !frame.T_D_B; ++c) {
+      const CameraObservation& obs = *observations[c];
+      if (cameras[c] && !obs.reason.empty()) reason += "; " + cameras[c]->name + ": " + obs.reason;
+    }
+    std::replace(reason.begin(), reason.end(), ',', ';');
+    if (!frame.T_D_B) ++no_pose_reasons[frame.reason];
+    stages.Line(stage_row + "," + reason);
     if (frame.T_D_B) fused.Append({t, *frame.T_D_B});
     if (frame.T_D_B_stereo) stereo.Append({t, *frame.T_D_B_stereo});
     if (frame.T_D_B_mono) mono.Append({t, *frame.T_D_B_mono});
@@ -157,7 +175,11 @@ void RunFrontend(const FrontendOptions& options) {
     std::printf(" %s %d", VisibilityStageName(static_cast<VisibilityStage>(s)),
                 n_by_stage[static_cast<VisibilityStage>(s)]);
   }
-  std::printf("\n  time per frame: decode %.2f ms, front-end %.2f ms (all cameras)\n",
+  std::printf("\n");
+  for (const auto& [reason, count] : no_pose_reasons) {
+    std::printf("  no pose: %d x %s\n", count, reason.c_str());
+  }
+  std::printf("  time per frame: decode %.2f ms, front-end %.2f ms (all cameras)\n",
               1e3 * decode_s / n_frames, 1e3 * frontend_s / n_frames);
 }
 
@@ -173,6 +195,9 @@ void AddFrontendCommand(CLI::App& root) {
   sub->add_flag("--no-tracking", options->no_tracking,
                 "Identify every frame from scratch (the paper's frame-independent matching)");
   sub->add_option("--matcher", options->matcher, "ransac (default) or omnidirectional");
+  sub->add_option("--detector", options->detector,
+                  "contrast (default: developed on our renders) or blob (real water: "
+                  "blob_light_detector.h, the dock's colour)");
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { RunFrontend(*options); });
 }

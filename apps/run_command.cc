@@ -28,6 +28,7 @@ struct RunOptions {
   std::string out;
   std::string config;
   bool quiet = false;
+  std::string detector = "contrast";
 };
 
 using Clock = std::chrono::steady_clock;
@@ -39,7 +40,7 @@ void Run(const RunOptions& options) {
   std::vector<std::string> skipped_rows;
   const Dataset dataset = LoadDataset(options.dataset, &skipped_rows);
   if (!dataset.calibration.imu) throw InputError(options.dataset + ": calibration has no IMU");
-  VisionFrameSource source(dataset);
+  VisionFrameSource source(dataset, ParseDetectorKind(options.detector));
   SlidingWindowEstimator estimator(dataset.calibration, *dataset.dock, config.estimator);
   GoNoGo go_no_go(config.go_no_go);
   EstimateWriter writer(options.out);
@@ -47,9 +48,18 @@ void Run(const RunOptions& options) {
 
   const CancellationToken cancel = InstallSignalCancellation();
   RunCounters counters;
-  size_t next_imu = 0, log_printed = 0;
+  size_t next_imu = 0;
+  // The pipeline's prediction at a frame: the estimate propagated with the IMU up to the frame
+  // (causal: samples at or before the frame time).
+  const VisionFrameSource::Predictor predict = [&](int64_t t_ns) {
+    while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= t_ns) {
+      estimator.AddImu(dataset.imu[next_imu++]);
+    }
+    return estimator.PropagatedPose(t_ns);
+  };
+  size_t log_printed = 0;
   try {
-    while (const std::optional<VisionFrame> frame = source.Next()) {
+    while (const std::optional<VisionFrame> frame = source.Next(predict)) {
       const auto t0 = Clock::now();
       while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= frame->t_ns) {
         estimator.AddImu(dataset.imu[next_imu++]);
@@ -87,6 +97,9 @@ void Run(const RunOptions& options) {
   std::printf("run: %d frames -> %s: %d estimates, %d GO, %d resets, %zu skipped rows\n",
               counters.frames, options.out.c_str(), stats.frames_with_output, counters.go,
               stats.resets, skipped_rows.size());
+  for (const auto& [reason, count] : source.no_vision_reasons()) {
+    std::printf("  no vision: %d frames: %s\n", count, reason.c_str());
+  }
   std::printf("  per frame: decode %.2f ms, front-end %.2f ms, back-end %.2f ms\n",
               1e3 * source.decode_s() / counters.frames,
               1e3 * source.frontend_s() / counters.frames, 1e3 * counters.backend_s / counters.frames);
@@ -101,6 +114,8 @@ void AddRunCommand(CLI::App& root) {
   sub->add_option("--dataset", options->dataset, "Dataset folder")->required();
   sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
   sub->add_option("--config", options->config, "Estimator and go/no-go options (YAML)");
+  sub->add_option("--detector", options->detector,
+                  "contrast (default: developed on our renders) or blob (real water)");
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { Run(*options); });
 }

@@ -24,6 +24,7 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                         {"observations", stats.skipped_observations}};
   summary["vision_residuals"] = {{"used", stats.used_observations},
                                  {"gated", stats.gated_observations}};
+  summary["no_vision_reasons"] = source.no_vision_reasons();
   summary["resets"] = stats.resets;
   summary["solver_failures"] = stats.solver_failures;
   summary["covariance_failures"] = stats.covariance_failures;

@@ -27,6 +27,7 @@ struct SmoothOptions {
   std::string out;
   std::string config;
   bool quiet = false;
+  std::string detector = "contrast";
 };
 
 using Clock = std::chrono::steady_clock;
@@ -38,7 +39,7 @@ void Smooth(const SmoothOptions& options) {
   std::vector<std::string> skipped_rows;
   const Dataset dataset = LoadDataset(options.dataset, &skipped_rows);
   if (!dataset.calibration.imu) throw InputError(options.dataset + ": calibration has no IMU");
-  VisionFrameSource source(dataset);
+  VisionFrameSource source(dataset, ParseDetectorKind(options.detector));
   SlidingWindowEstimator estimator(dataset.calibration, *dataset.dock, config.estimator);
   EstimateWriter writer(options.out);
 
@@ -46,7 +47,15 @@ void Smooth(const SmoothOptions& options) {
   RunCounters counters;
   std::vector<VisionFrame> frames;
   size_t next_imu = 0;
-  while (std::optional<VisionFrame> frame = source.Next()) {
+  // The pipeline's prediction at a frame: the estimate propagated with the IMU up to the frame
+  // (causal: samples at or before the frame time).
+  const VisionFrameSource::Predictor predict = [&](int64_t t_ns) {
+    while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= t_ns) {
+      estimator.AddImu(dataset.imu[next_imu++]);
+    }
+    return estimator.PropagatedPose(t_ns);
+  };
+  while (std::optional<VisionFrame> frame = source.Next(predict)) {
     cancel.ThrowIfCancelled();
     const auto t0 = Clock::now();
     while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= frame->t_ns) {
@@ -105,6 +114,9 @@ void Smooth(const SmoothOptions& options) {
               counters.frames, options.out.c_str(), result.stats.frames_with_output,
               result.segments, counters.go, result.iterations, result.initial_cost,
               result.final_cost);
+  for (const auto& [reason, count] : source.no_vision_reasons()) {
+    std::printf("  no vision: %d frames: %s\n", count, reason.c_str());
+  }
 }
 
 }  // namespace
@@ -116,6 +128,8 @@ void AddSmoothCommand(CLI::App& root) {
   sub->add_option("--dataset", options->dataset, "Dataset folder")->required();
   sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
   sub->add_option("--config", options->config, "Estimator and go/no-go options (YAML)");
+  sub->add_option("--detector", options->detector,
+                  "contrast (default: developed on our renders) or blob (real water)");
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { Smooth(*options); });
 }

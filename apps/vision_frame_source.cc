@@ -12,6 +12,12 @@
 namespace auvdock::cli {
 namespace {
 
+PaperBaselineOptions PipelineOptions(LightDetectorKind detector) {
+  PaperBaselineOptions options;
+  options.detector_kind = detector;
+  return options;
+}
+
 using Clock = std::chrono::steady_clock;
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
@@ -41,8 +47,14 @@ cv::Mat ReadImage(const CameraFrame& frame, const CameraCalibration& camera, int
 
 }  // namespace
 
-VisionFrameSource::VisionFrameSource(const Dataset& dataset)
-    : pipeline_(dataset.calibration, RequireDock(dataset)) {
+LightDetectorKind ParseDetectorKind(const std::string& name) {
+  if (name == "contrast") return LightDetectorKind::kContrast;
+  if (name == "blob") return LightDetectorKind::kBlob;
+  throw InputError("--detector: expected contrast or blob (got '" + name + "')");
+}
+
+VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind detector)
+    : pipeline_(dataset.calibration, RequireDock(dataset), PipelineOptions(detector)) {
   cameras_ = {pipeline_.left_camera(), pipeline_.right_camera(), pipeline_.mono_camera()};
   for (int c = 0; c < 3; ++c) {
     if (!cameras_[c] || !dataset.camera_frames.count(cameras_[c]->name)) continue;
@@ -55,7 +67,7 @@ VisionFrameSource::VisionFrameSource(const Dataset& dataset)
   next_ = times_.begin();
 }
 
-std::optional<VisionFrame> VisionFrameSource::Next() {
+std::optional<VisionFrame> VisionFrameSource::Next(const Predictor& predict) {
   if (next_ == times_.end()) return std::nullopt;
   const int64_t t = *next_++;
   const auto t0 = Clock::now();
@@ -67,8 +79,17 @@ std::optional<VisionFrame> VisionFrameSource::Next() {
     }
   }
   const auto t1 = Clock::now();
-  const BaselineFrame frame = pipeline_.Process(t, images[0], images[1], images[2]);
+  const BaselineFrame frame = pipeline_.Process(t, images[0], images[1], images[2],
+                                                predict ? predict(t) : std::nullopt);
   VisionFrame vision = MakeVisionFrame(frame, cameras_[0], cameras_[1], cameras_[2]);
+  if (vision.empty()) {
+    std::string reason = frame.reason.empty() ? "no identified light" : frame.reason;
+    // Counted by the reason's words, not its figures ("only 2 detections" ~ "only 3 ...").
+    const size_t detail = reason.find_first_of("0123456789({");
+    if (detail != std::string::npos && detail > 0) reason = reason.substr(0, detail);
+    while (!reason.empty() && (reason.back() == ' ' || reason.back() == ',')) reason.pop_back();
+    ++no_vision_reasons_[reason];
+  }
   decode_s_ += Seconds(t1 - t0);
   frontend_s_ += Seconds(Clock::now() - t1);
   return vision;

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -16,13 +17,24 @@
 
 namespace auvdock::cli {
 
+// "contrast" or "blob" (the --detector option); throws InputError otherwise.
+LightDetectorKind ParseDetectorKind(const std::string& name);
+
 class VisionFrameSource {
  public:
   // Throws InputError when the dataset has no dock or no camera frames.
-  explicit VisionFrameSource(const Dataset& dataset);
+  explicit VisionFrameSource(const Dataset& dataset,
+                             LightDetectorKind detector = LightDetectorKind::kContrast);
 
-  // The next frame, or nothing at the end.
-  std::optional<VisionFrame> Next();
+  // A body pose T_D_B predicted for a frame time (the estimator's IMU propagation), or nothing.
+  using Predictor = std::function<std::optional<Pose3>(int64_t t_ns)>;
+
+  // The next frame, or nothing at the end. predict (optional) lets the pipeline track and
+  // resolve a symmetric dock when its own last pose is too old.
+  std::optional<VisionFrame> Next(const Predictor& predict = {});
+
+  // Frames that gave the estimator no vision, counted by the pipeline's reason.
+  const std::map<std::string, int>& no_vision_reasons() const { return no_vision_reasons_; }
 
   size_t num_frames() const { return times_.size(); }
   int64_t first_t_ns() const { return *times_.begin(); }
@@ -39,6 +51,7 @@ class VisionFrameSource {
   std::set<int64_t>::const_iterator next_;
   double decode_s_ = 0.0, frontend_s_ = 0.0;
   int unreadable_images_ = 0;
+  std::map<std::string, int> no_vision_reasons_;
 };
 
 }  // namespace auvdock::cli

@@ -26,6 +26,8 @@ DockModel LoadDockModel(const std::string& path) {
     root.Fail("gravity_D", "magnitude must be between 9 and 10.5 m/s^2");
   }
   dock.p_D_beacon = root.GetVector<3>("beacon_p_D", dock.p_D_beacon);
+  dock.approach_direction_D =
+      root.GetVector<3>("approach_direction_D", dock.approach_direction_D);
   const ConfigNode deck = root.ChildOrEmpty("deck");
   dock.deck_length_m = deck.GetPositive("length_m", dock.deck_length_m);
   dock.deck_width_m = deck.GetPositive("width_m", dock.deck_width_m);
@@ -55,6 +57,9 @@ void SaveDockModel(const DockModel& dock, const std::string& path) {
   EmitNumber(out, "origin_depth_m", dock.origin_depth_m);
   EmitVector3(out, "gravity_D", dock.gravity_D);
   EmitVector3(out, "beacon_p_D", dock.p_D_beacon);
+  if (dock.approach_direction_D.norm() > 0.0) {
+    EmitVector3(out, "approach_direction_D", dock.approach_direction_D);
+  }
   out << YAML::Key << "deck" << YAML::Value << YAML::BeginMap;
   EmitNumber(out, "length_m", dock.deck_length_m);
   EmitNumber(out, "width_m", dock.deck_width_m);

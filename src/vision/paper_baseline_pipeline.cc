@@ -9,6 +9,15 @@
 #include "auvdock/vision/point_set_alignment.h"
 
 namespace auvdock {
+namespace {
+
+// The blob detector's options with the dock's light colour.
+BlobLightDetectorOptions WithDockColour(BlobLightDetectorOptions options, const DockModel& dock) {
+  options.checks.colour = ParseLightColour(dock.light_colour);
+  return options;
+}
+
+}  // namespace
 
 int CameraObservation::num_identified() const {
   return static_cast<int>(std::count_if(light_ids.begin(), light_ids.end(),
@@ -19,6 +28,10 @@ PaperBaselinePipeline::PaperBaselinePipeline(const Calibration& calibration,
                                              const DockModel& dock,
                                              const PaperBaselineOptions& options)
     : calibration_(calibration), dock_(dock), options_(options), detector_(options.detector),
+      blob_detector_(WithDockColour(options.blob_detector, dock)),
+      colour_learners_{HaloColourLearner(options.blob_detector.checks.min_halo_excess),
+                       HaloColourLearner(options.blob_detector.checks.min_halo_excess),
+                       HaloColourLearner(options.blob_detector.checks.min_halo_excess)},
       rng_(options.seed) {
   left_ = calibration_.FindCameraByRole(CameraRole::kStereoLeft);
   right_ = calibration_.FindCameraByRole(CameraRole::kStereoRight);
@@ -29,8 +42,10 @@ std::optional<Pose3> PaperBaselinePipeline::Predict(const CameraCalibration& cam
                                                     int64_t t_ns) const {
   const bool recent = last_T_D_B_ && static_cast<double>(t_ns - last_t_ns_) * 1e-9 <=
                                          options_.tracking_max_age_s;
-  if (!options_.use_tracking || !recent) return std::nullopt;
-  return (*last_T_D_B_ * camera.T_B_C).Inverse();
+  if (!options_.use_tracking) return std::nullopt;
+  if (recent) return (*last_T_D_B_ * camera.T_B_C).Inverse();
+  if (external_T_D_B_) return (*external_T_D_B_ * camera.T_B_C).Inverse();
+  return std::nullopt;
 }
 
 std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& camera,
@@ -43,9 +58,17 @@ std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& ca
   } else {
     RansacMatcherOptions ransac = options_.ransac;
     ransac.pixel_noise_px = camera.pixel_noise_px;
-    RansacMatchResult result = MatchRansac(obs->detections, dock_, camera.intrinsics, ransac, rng_);
+    // A symmetric dock's poses: the copy nearest the prediction, else the approach side.
+    SymmetryHint hint;
+    hint.predicted_T_C_D = Predict(camera, t_ns);
+    if (dock_.approach_direction_D.norm() > 0.0) {
+      hint.approach_direction_D = dock_.approach_direction_D;
+    }
+    RansacMatchResult result =
+        MatchRansac(obs->detections, dock_, camera.intrinsics, ransac, rng_, hint);
     T_C_D = result.T_C_D;
     match = result;
+    obs->symmetry = result.symmetry;
   }
   const std::optional<Pose3> predicted_T_C_D = Predict(camera, t_ns);
   if (match.status != MatchStatus::kOk && predicted_T_C_D) {
@@ -190,19 +213,34 @@ void PaperBaselinePipeline::MonoPose(const std::optional<Pose3>& predicted_T_C_D
 }
 
 BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
-                                             const cv::Mat& right, const cv::Mat& mono) {
-  auto detect = [&](const CameraCalibration* camera, const cv::Mat& image) {
+                                             const cv::Mat& right, const cv::Mat& mono,
+                                             const std::optional<Pose3>& predicted_T_D_B) {
+  auto detect = [&](const CameraCalibration* camera, const cv::Mat& image, int index) {
     std::optional<std::vector<LightDetection>> detections;
-    if (camera && !image.empty()) detections = detector_.Detect(image);
+    if (!camera || image.empty()) return detections;
+    if (options_.detector_kind == LightDetectorKind::kBlob) {
+      detections = blob_detector_.Detect(image, nullptr, colour_learners_[index].threshold());
+    } else {
+      detections = detector_.Detect(image);
+    }
     return detections;
   };
-  return ProcessDetections(t_ns, detect(left_, left), detect(right_, right), detect(mono_, mono));
+  BaselineFrame frame = ProcessDetections(t_ns, detect(left_, left, 0), detect(right_, right, 1),
+                                          detect(mono_, mono, 2), predicted_T_D_B);
+  if (options_.detector_kind == LightDetectorKind::kBlob) {
+    colour_learners_[0].Observe(frame.left.detections, frame.left.light_ids);
+    colour_learners_[1].Observe(frame.right.detections, frame.right.light_ids);
+    colour_learners_[2].Observe(frame.mono.detections, frame.mono.light_ids);
+  }
+  return frame;
 }
 
 BaselineFrame PaperBaselinePipeline::ProcessDetections(
     int64_t t_ns, const std::optional<std::vector<LightDetection>>& left,
     const std::optional<std::vector<LightDetection>>& right,
-    const std::optional<std::vector<LightDetection>>& mono) {
+    const std::optional<std::vector<LightDetection>>& mono,
+    const std::optional<Pose3>& predicted_T_D_B) {
+  external_T_D_B_ = predicted_T_D_B;
   BaselineFrame frame;
   frame.t_ns = t_ns;
   const bool have_stereo = left_ && right_ && left && right;

@@ -40,6 +40,10 @@ struct DockModel {
   double origin_depth_m = 30.0;
   // Acoustic (USBL/SBL) beacon / transponder position on the platform.
   Eigen::Vector3d p_D_beacon = Eigen::Vector3d::Zero();
+  // Where vehicles come from, seen from the dock (any length, D frame; e.g. (-1, 0, -1): from
+  // behind the docking axis and above), when the dock's operators know it. It tells a symmetric
+  // layout's poses apart (dock_symmetry.h); zero: unknown.
+  Eigen::Vector3d approach_direction_D = Eigen::Vector3d::Zero();
 
   // True when every light lies within tolerance_m of one line (pose about it unobservable).
   bool LightsCollinear(double tolerance_m = 1e-3) const;

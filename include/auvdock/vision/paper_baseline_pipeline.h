@@ -43,6 +43,7 @@
 // Frames: D dock (z down), B body, C camera (OpenCV). Units: metres, radians, pixels.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <random>
@@ -54,6 +55,8 @@
 #include "auvdock/geometry/dock_model.h"
 #include "auvdock/io/calibration.h"
 #include "auvdock/io/measurements.h"
+#include "auvdock/vision/blob_light_detector.h"
+#include "auvdock/vision/halo_colour_learner.h"
 #include "auvdock/vision/light_detector.h"
 #include "auvdock/vision/ransac_matcher.h"
 #include "auvdock/vision/stereo_triangulation.h"
@@ -63,8 +66,15 @@ namespace auvdock {
 
 enum class BaselineMatcher { kRansac, kOmnidirectional };
 
+// kContrast: LightDetector (light_detector.h), developed on our renders; kBlob: the real-water
+// BlobLightDetector (blob_light_detector.h) with a halo colour learned per camera from the
+// identified lights (halo_colour_learner.h).
+enum class LightDetectorKind { kContrast, kBlob };
+
 struct PaperBaselineOptions {
+  LightDetectorKind detector_kind = LightDetectorKind::kContrast;
   LightDetectorOptions detector;
+  BlobLightDetectorOptions blob_detector;
   BaselineMatcher matcher = BaselineMatcher::kRansac;
   RansacMatcherOptions ransac;
   StereoMatchOptions stereo;
@@ -86,6 +96,7 @@ struct CameraObservation {
   std::vector<int> light_ids;  // per detection: dock light id, or -1 when not identified
   MatchStatus status = MatchStatus::kFailed;
   std::string reason;
+  std::string symmetry;  // how a symmetric dock's pose was chosen (empty: not symmetric)
   bool tracked = false;  // identified by prediction (tracking) rather than from scratch
   int num_identified() const;
 };
@@ -110,16 +121,20 @@ class PaperBaselinePipeline {
   PaperBaselinePipeline(const Calibration& calibration, const DockModel& dock,
                         const PaperBaselineOptions& options = {});
 
-  // Any image may be empty (camera absent or image unreadable).
+  // Any image may be empty (camera absent or image unreadable). predicted_T_D_B: the body pose
+  // at t_ns known from elsewhere (the estimator's IMU propagation), used for tracking and for
+  // choosing among a symmetric dock's poses when the pipeline's own last pose is too old.
   BaselineFrame Process(int64_t t_ns, const cv::Mat& left, const cv::Mat& right,
-                        const cv::Mat& mono);
+                        const cv::Mat& mono,
+                        const std::optional<Pose3>& predicted_T_D_B = std::nullopt);
 
   // Steps 2-5 on detections made elsewhere (Process = LightDetector::Detect on each image, then
   // this); std::nullopt for an absent camera or image.
   BaselineFrame ProcessDetections(int64_t t_ns,
                                   const std::optional<std::vector<LightDetection>>& left,
                                   const std::optional<std::vector<LightDetection>>& right,
-                                  const std::optional<std::vector<LightDetection>>& mono);
+                                  const std::optional<std::vector<LightDetection>>& mono,
+                                  const std::optional<Pose3>& predicted_T_D_B = std::nullopt);
 
   const CameraCalibration* left_camera() const { return left_; }
   const CameraCalibration* right_camera() const { return right_; }
@@ -142,8 +157,11 @@ class PaperBaselinePipeline {
   DockModel dock_;
   PaperBaselineOptions options_;
   LightDetector detector_;
+  BlobLightDetector blob_detector_;
+  std::array<HaloColourLearner, 3> colour_learners_;  // left, right, mono
   std::mt19937_64 rng_;
   std::optional<Pose3> last_T_D_B_;  // the previous reported pose, for tracking
+  std::optional<Pose3> external_T_D_B_;  // this frame's prediction from elsewhere, if any
   int64_t last_t_ns_ = 0;
   const CameraCalibration* left_ = nullptr;
   const CameraCalibration* right_ = nullptr;
