@@ -20,6 +20,8 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.max_imu_gap_s = est.GetPositive("max_imu_gap_s", e.max_imu_gap_s);
   e.vision.use_mono = est.GetBool("use_mono", e.vision.use_mono);
   e.vision.use_stereo = est.GetBool("use_stereo", e.vision.use_stereo);
+  e.adaptive_vision_noise.enabled =
+      est.GetBool("adaptive_vision_noise", e.adaptive_vision_noise.enabled);
   e.vision.stereo_covariance_at_prediction =
       est.GetBool("stereo_covariance_at_prediction", e.vision.stereo_covariance_at_prediction);
   const std::string weighting = est.GetString("stage_weighting", "information");

@@ -42,6 +42,11 @@ std::optional<Eigen::Matrix3d> PredictedStereoCovariance(const VisionRig& rig, c
   return predicted.covariance;
 }
 
+double Factor(const std::map<int, double>& factors, int light_id) {
+  const auto it = factors.find(light_id);
+  return it == factors.end() ? 1.0 : it->second;
+}
+
 }  // namespace
 
 std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const VisionFrame& frame,
@@ -69,7 +74,7 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
       continue;
     }
     const Eigen::Matrix2d covariance =
-        Eigen::Matrix2d::Identity() *
+        Eigen::Matrix2d::Identity() * Factor(options.mono_variance_factor, obs.light_id) *
         (obs.sigma_px * obs.sigma_px + options.correlated_pixel_variance);
     auto factor = std::make_unique<MonoReprojectionFactor>(obs.uv, covariance, rig.mono->intrinsics,
                                                            rig.mono->T_B_C, light->p_D);
@@ -83,7 +88,7 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
     const ceres::ResidualBlockId id = problem->AddResidualBlock(
         MonoReprojectionFactor::Create(std::move(factor)),
         WeightedHuber(options.huber_sigmas, weights.mono), pose);
-    added.push_back({id, true});
+    added.push_back({id, true, obs.light_id, weights.mono});
   }
   // The body pose the stereo covariances are evaluated at, once per frame.
   std::optional<Pose3> T_B_D_predicted;
@@ -105,10 +110,12 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
       }
     }
     const ceres::ResidualBlockId id = problem->AddResidualBlock(
-        StereoPointFactor::Create(obs.p_S, stereo_scale * covariance, rig.stereo_left->T_B_C,
-                                  light->p_D),
+        StereoPointFactor::Create(obs.p_S,
+                                  Factor(options.stereo_variance_factor, obs.light_id) *
+                                      stereo_scale * covariance,
+                                  rig.stereo_left->T_B_C, light->p_D),
         WeightedHuber(options.huber_sigmas, weights.stereo), pose);
-    added.push_back({id, false});
+    added.push_back({id, false, obs.light_id, weights.stereo});
   }
   return added;
 }

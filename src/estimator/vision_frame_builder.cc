@@ -1,5 +1,7 @@
 #include "auvdock/estimator/vision_frame_builder.h"
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "auvdock/vision/stereo_triangulation.h"
@@ -34,8 +36,12 @@ VisionFrame MakeVisionFrame(const BaselineFrame& frame, const CameraCalibration*
     for (const auto& [id, i] : IdentifiedLights(frame.mono)) {
       MonoLightObservation obs;
       obs.light_id = id;
-      obs.uv = frame.mono.detections[i].uv;
-      obs.sigma_px = mono->pixel_noise_px;
+      const LightDetection& detection = frame.mono.detections[i];
+      obs.uv = detection.uv;
+      // The detector's own centroid covariance when it measures one (never below the camera's
+      // figure): a light cut by the border or smeared carries a wider one.
+      obs.sigma_px = std::max(mono->pixel_noise_px,
+                              std::sqrt(std::max(0.0, detection.covariance.trace()) / 2.0));
       out.mono.push_back(obs);
     }
   }

@@ -1,6 +1,5 @@
 // BlobLightDetector on scenes drawn here, independently of the simulator's renderer: blue LEDs
-// (a saturated white core in a bright blue halo, as close LEDs bloom in the real pool footage:
-// b - r of the halo ~100-170 gray levels 5-10 px from the core) beside a large white-green funnel, white spots, a
+// (tests/testing/led_image.h) beside a large white-green funnel, white spots, a
 // yellow-green textured wall, JPEG compression; and its parts (candidates, core centroid).
 #include "auvdock/vision/blob_light_detector.h"
 
@@ -15,39 +14,13 @@
 
 #include "auvdock/vision/field_deinterlace.h"
 #include "auvdock/vision/halo_colour_learner.h"
+#include "tests/testing/led_image.h"
 
 namespace auvdock {
 namespace {
 
-struct Led {
-  Eigen::Vector2d uv;
-  double core_px;  // radius of the saturated core
-  double halo_px;  // sigma of the blue halo
-};
-
-// BGR float image, values 0-255 before clipping.
-void AddLed(const Led& led, cv::Mat* image) {
-  const int r = static_cast<int>(std::ceil(4 * led.halo_px + led.core_px));
-  for (int y = std::max(0, int(led.uv.y()) - r); y < std::min(image->rows, int(led.uv.y()) + r); ++y) {
-    for (int x = std::max(0, int(led.uv.x()) - r); x < std::min(image->cols, int(led.uv.x()) + r);
-         ++x) {
-      // 4 x 4 supersampling of the core disc, so that its centroid is the true centre.
-      double core = 0.0;
-      for (int sy = 0; sy < 4; ++sy) {
-        for (int sx = 0; sx < 4; ++sx) {
-          const double dx = x - 0.375 + 0.25 * sx - led.uv.x();
-          const double dy = y - 0.375 + 0.25 * sy - led.uv.y();
-          core += (dx * dx + dy * dy <= led.core_px * led.core_px) / 16.0;
-        }
-      }
-      const double d2 = (x - led.uv.x()) * (x - led.uv.x()) + (y - led.uv.y()) * (y - led.uv.y());
-      const double halo = std::exp(-0.5 * d2 / (led.halo_px * led.halo_px));
-      cv::Vec3f& p = image->at<cv::Vec3f>(y, x);
-      p += cv::Vec3f(320.0f, 170.0f, 50.0f) * static_cast<float>(halo) +
-           cv::Vec3f(400.0f, 400.0f, 400.0f) * static_cast<float>(core);
-    }
-  }
-}
+using test::AddLed;
+using test::Led;
 
 struct Scene {
   cv::Mat bgr;

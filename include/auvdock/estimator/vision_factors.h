@@ -28,6 +28,7 @@
 // weight) exceeds its chi-square gate is removed.
 #pragma once
 
+#include <map>
 #include <vector>
 
 #include <ceres/problem.h>
@@ -46,11 +47,19 @@ struct VisionFactorOptions {
   bool stereo_covariance_at_prediction = true;
   StageWeightingOptions stage_weighting;
   double correlated_pixel_variance = 0.0;  // px^2 added per pixel coordinate (see above)
+  // Variance factors per light id of the mono pixels and of the stereo points
+  // (adaptive_noise_scale.h: the sliding window's online estimate of each light's effective
+  // centroid noise in each camera system); a missing id = 1, as configured. They multiply the
+  // covariances above.
+  std::map<int, double> mono_variance_factor;
+  std::map<int, double> stereo_variance_factor;
 };
 
 struct VisionResidual {
   ceres::ResidualBlockId id = nullptr;
   bool mono = false;
+  int light_id = -1;
+  double weight = 1.0;  // the stage weight on its information
 };
 
 // What the factors need to know about the rig and the dock. Any camera may be null (without

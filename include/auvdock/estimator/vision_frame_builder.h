@@ -2,7 +2,8 @@
 // (PaperBaselinePipeline: detections identified against the dock model) into the estimator's
 // VisionFrame.
 //
-//   mono:   every identified detection of the mono camera, with the camera's pixel noise;
+//   mono:   every identified detection of the mono camera, with the camera's pixel noise or the
+//           detection's own centroid covariance (sqrt(trace / 2)) when that is larger;
 //   stereo: every light identified in both stereo images, triangulated (TriangulateLinear,
 //           seed 000 eqs. 11-16) in S = the stereo-left camera frame, with the covariance of
 //           the pixel noise propagated through the triangulation (depth is the weak direction);

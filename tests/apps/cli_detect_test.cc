@@ -1,0 +1,191 @@
+// auvdock detect end to end on images drawn here (a flat ring of 8 blue LEDs, 4-fold symmetric,
+// seen from 2.5-3.5 m): every file written, every frame posed with its symmetry stated, the
+// identities consistent from frame to frame, the detector measured against labels; and the bad
+// input that is one line and exit 2.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "auvdock/geometry/pose3.h"
+#include "auvdock/geometry/so3.h"
+#include "auvdock/io/dock_io.h"
+#include "tests/testing/led_image.h"
+#include "tests/testing/run_command.h"
+#include "tests/testing/temp_dir.h"
+
+namespace auvdock {
+namespace {
+
+constexpr double kF = 500.0, kCx = 319.5, kCy = 239.5;
+
+const char* kCalibration =
+    "cameras:\n"
+    "  - name: cam0\n"
+    "    role: mono\n"
+    "    resolution: [640, 480]\n"
+    "    camera_model: pinhole\n"
+    "    intrinsics: [500, 500, 319.5, 239.5]\n"
+    "    distortion_model: radial-tangential\n"
+    "    distortion_coefficients: [0, 0, 0, 0, 0]\n"
+    "    rate_hz: 10\n"
+    "    pixel_noise_px: 0.5\n"
+    "    T_B_S: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]\n";
+
+struct Footage {
+  test::TempDir dir;
+  std::vector<std::vector<std::pair<int, Eigen::Vector2d>>> truth;  // per frame: id, pixel
+};
+
+// Frames of the ring, the camera looking down from 3 m, drifting and turning slowly.
+void MakeFootage(Footage* footage, int frames) {
+  DockModel dock = LoadDockModel(std::string(AUVDOCK_SOURCE_DIR) + "/data/docks/ring_8.yaml");
+  dock.light_colour = "blue";
+  SaveDockModel(dock, footage->dir / "dock.yaml");
+  test::WriteTextFile(footage->dir / "calibration.yaml", kCalibration);
+  std::ofstream labels(footage->dir / "labels.csv");
+  labels << "frame_file,u,v,status,quality\n";
+  for (int f = 0; f < frames; ++f) {
+    const double a = 0.03 * f;
+    const Pose3 T_C_D(ExpQuaternion(Eigen::Vector3d(0.05 * std::sin(a), -0.04, 0.2 + 0.02 * f)),
+                      Eigen::Vector3d(0.1 * std::cos(a), -0.05 + 0.01 * f, 3.0 - 0.02 * f));
+    cv::Mat image(480, 640, CV_32FC3, cv::Scalar(30, 95, 90));
+    std::vector<std::pair<int, Eigen::Vector2d>> seen;
+    for (const DockLight& light : dock.lights) {
+      const Eigen::Vector3d p = T_C_D * light.p_D;
+      const Eigen::Vector2d uv(kF * p.x() / p.z() + kCx, kF * p.y() / p.z() + kCy);
+      test::AddLed({uv, 3.0, 7.0}, &image);
+      seen.emplace_back(light.id, uv);
+    }
+    cv::Mat bgr;
+    image.convertTo(bgr, CV_8UC3);
+    char name[32];
+    std::snprintf(name, sizeof(name), "f%03d.png", f);
+    cv::imwrite(footage->dir / ("frames/" + std::string(name)), bgr);
+    for (const auto& [id, uv] : seen) labels << name << "," << uv.x() << "," << uv.y() << ",ok,good\n";
+    footage->truth.push_back(seen);
+  }
+}
+
+std::vector<std::string> DetectArgs(const Footage& footage, const std::string& out) {
+  return {"detect", "--images", footage.dir / "frames/*.png", "--calib",
+          footage.dir / "calibration.yaml", "--dock", footage.dir / "dock.yaml", "--out", out,
+          "--labels", footage.dir / "labels.csv", "--overlay", "--quiet"};
+}
+
+TEST(DetectCli, PosesEveryFrameOfASymmetricRingWithConsistentIdentities) {
+  Footage footage;
+  std::filesystem::create_directories(footage.dir / "frames");
+  MakeFootage(&footage, 12);
+  const std::string out = footage.dir / "out";
+  const test::CommandResult r = test::RunAuvdock(DetectArgs(footage, out));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  for (const char* file : {"detections.csv", "frames.csv", "camera_poses.tum", "summary.json",
+                           "rejected.csv", "overlay/f000.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(out + "/" + file)) << file;
+  }
+  const nlohmann::json summary = nlohmann::json::parse(test::ReadTextFile(out + "/summary.json"));
+  EXPECT_EQ(summary["frames_with_pose"], 12);
+  EXPECT_EQ(summary["labels"]["recall"], 1.0);
+  EXPECT_EQ(summary["labels"]["precision"], 1.0);
+  EXPECT_LT(summary["labels"]["centroid_rms_px"].get<double>(), 0.3);
+  EXPECT_EQ(summary["labels"]["pose_rate"], 1.0);
+
+  // The identities: each true light keeps one reported id through the footage (which one is
+  // defined up to the ring's symmetry: the first frame says so).
+  std::ifstream frames(out + "/frames.csv");
+  std::string line;
+  std::getline(frames, line);
+  std::getline(frames, line);
+  EXPECT_NE(line.find("4-fold"), std::string::npos) << line;
+  EXPECT_NE(line.find("unresolved"), std::string::npos) << line;
+  std::map<int, int> reported_of_true;
+  std::ifstream detections(out + "/detections.csv");
+  std::getline(detections, line);
+  while (std::getline(detections, line)) {
+    std::stringstream s(line);
+    std::string frame, image, id, u, v;
+    std::getline(s, frame, ',');
+    std::getline(s, image, ',');
+    std::getline(s, id, ',');
+    std::getline(s, u, ',');
+    std::getline(s, v, ',');
+    const Eigen::Vector2d uv(std::stod(u), std::stod(v));
+    int truth = -1;
+    for (const auto& [true_id, p] : footage.truth[std::stoi(frame)]) {
+      if ((p - uv).norm() < 1.0) truth = true_id;
+    }
+    ASSERT_GE(truth, 0) << line;
+    ASSERT_GE(std::stoi(id), 0) << line;
+    const auto [it, inserted] = reported_of_true.emplace(truth, std::stoi(id));
+    EXPECT_EQ(it->second, std::stoi(id)) << "light " << truth << " changed identity: " << line;
+  }
+  EXPECT_EQ(reported_of_true.size(), 8u);
+}
+
+TEST(DetectCli, GravityResolvesAnUprightRing) {
+  // The same footage with the ring standing upright in the dock file (gravity along +y of D)
+  // and a camera known to be upright: the first frame is resolved by gravity.
+  Footage footage;
+  std::filesystem::create_directories(footage.dir / "frames");
+  MakeFootage(&footage, 2);
+  DockModel dock = LoadDockModel(footage.dir / "dock.yaml");
+  dock.gravity_D = Eigen::Vector3d(0.0, 9.81, 0.0);
+  SaveDockModel(dock, footage.dir / "dock.yaml");
+  std::vector<std::string> args = DetectArgs(footage, footage.dir / "out");
+  for (const char* a : {"--gravity-camera", "0", "1", "0"}) args.push_back(a);
+  const test::CommandResult r = test::RunAuvdock(args);
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const std::string frames = test::ReadTextFile(footage.dir / "out/frames.csv");
+  EXPECT_NE(frames.find("chosen by gravity"), std::string::npos) << frames;
+}
+
+void ExpectOneLineExitTwo(const std::vector<std::string>& args, const std::string& needle) {
+  const test::CommandResult r = test::RunAuvdock(args);
+  EXPECT_EQ(r.exit_status, 2) << r.err;
+  EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+TEST(DetectCli, BadInputIsOneLineAndExitTwo) {
+  Footage footage;
+  std::filesystem::create_directories(footage.dir / "frames");
+  MakeFootage(&footage, 1);
+  auto args = [&](const std::string& out) { return DetectArgs(footage, footage.dir / out); };
+  std::vector<std::string> a = args("o1");
+  a[2] = footage.dir / "nothing/*.png";
+  ExpectOneLineExitTwo(a, "no file matches");
+
+  std::filesystem::create_directories(footage.dir / "small");
+  std::filesystem::create_directories(footage.dir / "grey");
+  cv::imwrite(footage.dir / "small/x.png", cv::Mat(100, 100, CV_8UC3, cv::Scalar(0, 0, 0)));
+  a = args("o2");
+  a[2] = footage.dir / "small/*.png";
+  ExpectOneLineExitTwo(a, "the image is 100x100, the calibration 640x480");
+
+  cv::imwrite(footage.dir / "grey/x.png", cv::Mat(480, 640, CV_8UC1, cv::Scalar(0)));
+  a = args("o3");
+  a[2] = footage.dir / "grey/*.png";
+  ExpectOneLineExitTwo(a, "a grey image, but the lights are blue");
+
+  test::WriteTextFile(footage.dir / "bad_labels.csv", "frame_file,u,v\nf000.png,1,oops\n");
+  a = args("o4");
+  a[10] = footage.dir / "bad_labels.csv";
+  ExpectOneLineExitTwo(a, "bad_labels.csv: line 2: column 'v'");
+
+  a = args("o5");
+  a.push_back("--colour");
+  a.push_back("purple");
+  ExpectOneLineExitTwo(a, "unknown light colour 'purple'");
+}
+
+}  // namespace
+}  // namespace auvdock
