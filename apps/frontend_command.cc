@@ -87,6 +87,9 @@ void RunFrontend(const FrontendOptions& options) {
     throw InputError("--matcher: expected ransac or omnidirectional (got '" + options.matcher + "')");
   }
   PaperBaselinePipeline pipeline(dataset.calibration, *dataset.dock, pipeline_options);
+  for (const std::string& w : pipeline.warnings()) {
+    std::fprintf(stderr, "auvdock: warning: %s\n", w.c_str());
+  }
   const std::vector<const CameraCalibration*> cameras = {
       pipeline.left_camera(), pipeline.right_camera(), pipeline.mono_camera()};
 

@@ -25,6 +25,7 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
   summary["vision_residuals"] = {{"used", stats.used_observations},
                                  {"gated", stats.gated_observations}};
   summary["no_vision_reasons"] = source.no_vision_reasons();
+  summary["warnings"] = source.warnings();
   summary["adaptive_variance_factor"] = {{"mono", stats.mono_variance_factor},
                                          {"stereo", stats.stereo_variance_factor}};
   summary["resets"] = stats.resets;

@@ -64,6 +64,9 @@ VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind d
     }
   }
   if (times_.empty()) throw InputError(dataset.root + ": no camera frames");
+  for (const std::string& w : pipeline_.warnings()) {
+    std::fprintf(stderr, "auvdock: warning: %s\n", w.c_str());
+  }
   next_ = times_.begin();
 }
 

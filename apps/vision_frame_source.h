@@ -33,6 +33,7 @@ class VisionFrameSource {
   // resolve a symmetric dock when its own last pose is too old.
   std::optional<VisionFrame> Next(const Predictor& predict = {});
 
+  const std::vector<std::string>& warnings() const { return pipeline_.warnings(); }
   // Frames that gave the estimator no vision, counted by the pipeline's reason.
   const std::map<std::string, int>& no_vision_reasons() const { return no_vision_reasons_; }
 

@@ -45,6 +45,15 @@ DockModel LoadDockModel(const std::string& path) {
     dock.lights.push_back(light);
   }
   if (dock.lights.size() < 3) root.Fail("lights", "at least 3 lights are needed");
+  // Two lights at one place cannot be told apart in an image (1 mm: any real layout is wider).
+  for (size_t i = 0; i < dock.lights.size(); ++i) {
+    for (size_t j = i + 1; j < dock.lights.size(); ++j) {
+      if ((dock.lights[i].p_D - dock.lights[j].p_D).norm() < 1e-3) {
+        root.Fail("lights", "lights " + std::to_string(dock.lights[i].id) + " and " +
+                                std::to_string(dock.lights[j].id) + " coincide");
+      }
+    }
+  }
   root.CheckNoUnknownKeys();
   return dock;
 }

@@ -59,7 +59,9 @@ std::vector<BlobCandidate> FindBlobCandidates(const cv::Mat& luma,
       const double next = level + 1;
       const double pixel = std::pow(2.0, next);
       const double residual2 = sigma * sigma - PyramidBlur(level + 1) * PyramidBlur(level + 1);
-      if (residual2 < pixel * pixel) break;  // less than one pixel of blur left at that level
+      // Less than one pixel of that level of blur left: the level would alias the scale (at
+      // 0.9 px the pool clip lost ~9 % of its posed frames).
+      if (residual2 < pixel * pixel) break;
       if ((level0.cols >> (level + 1)) < 16 || (level0.rows >> (level + 1)) < 16) break;
       level = static_cast<int>(next);
     }

@@ -36,6 +36,16 @@ PaperBaselinePipeline::PaperBaselinePipeline(const Calibration& calibration,
   left_ = calibration_.FindCameraByRole(CameraRole::kStereoLeft);
   right_ = calibration_.FindCameraByRole(CameraRole::kStereoRight);
   mono_ = calibration_.FindCameraByRole(CameraRole::kMono);
+  if ((left_ != nullptr) != (right_ != nullptr)) {
+    const CameraCalibration* lone = left_ ? left_ : right_;
+    warnings_.push_back("camera " + lone->name + " has role " +
+                        (left_ ? "stereo_left" : "stereo_right") + " but the rig has no " +
+                        (left_ ? "stereo_right" : "stereo_left") +
+                        ": its images are not used (a single camera takes role mono)");
+  }
+  if (!left_ && !right_ && !mono_) {
+    warnings_.push_back("no camera has role stereo_left, stereo_right or mono: no vision");
+  }
 }
 
 std::optional<Pose3> PaperBaselinePipeline::Predict(const CameraCalibration& camera,

@@ -88,6 +88,16 @@ TEST_F(ScenarioErrors, BadDockFileNamesTheDockFileAndKey) {
   test::WriteTextFile(dock, "name: bad\nlights:\n  - {id: 0, p_D: [0, 0]}\n");
   EXPECT_THAT(ErrorOf([&] { LoadDockModel(dock); }),
               AllOf(HasSubstr("lights[0].p_D"), HasSubstr("3 numbers")));
+  test::WriteTextFile(dock,
+                      "name: bad\nlights:\n  - {id: 0, p_D: [0, 0, 0]}\n  - {id: 1, p_D: [1, 0, 0]}\n"
+                      "  - {id: 2, p_D: [1, 0, 0.0002]}\n");
+  EXPECT_THAT(ErrorOf([&] { LoadDockModel(dock); }),
+              AllOf(HasSubstr(dock), HasSubstr("lights 1 and 2 coincide")));
+  test::WriteTextFile(dock,
+                      "name: bad\ncolour: purple\nlights:\n  - {id: 0, p_D: [0, 0, 0]}\n"
+                      "  - {id: 1, p_D: [1, 0, 0]}\n  - {id: 2, p_D: [1, 1, 0]}\n");
+  EXPECT_THAT(ErrorOf([&] { LoadDockModel(dock); }),
+              AllOf(HasSubstr(dock), HasSubstr("colour"), HasSubstr("purple")));
 }
 
 TEST(CalibrationErrors, BadRotationAndMissingKey) {

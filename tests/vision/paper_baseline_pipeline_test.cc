@@ -1,5 +1,6 @@
 #include "auvdock/vision/paper_baseline_pipeline.h"
 
+#include <algorithm>
 #include <map>
 #include <string>
 #include <optional>
@@ -59,6 +60,21 @@ std::vector<int> TrueIds(const std::vector<LightDetection>& detections,
 // vs 9.1 px) and accepts shifted ones. Left-right matching then paired the left image's lights 4
 // and 5 with the right image's 3 and 4 (same order along the line, a depth of ~3 m instead of
 // ~7 m) and the stereo pose came out ~10 m off.
+TEST(PaperBaselinePipelineTest, ALoneStereoCameraIsAWarningNotSilence) {
+  const Scenario scenario = test::DefaultScenario();
+  Calibration calibration = MakeCalibration(scenario);
+  EXPECT_TRUE(PaperBaselinePipeline(calibration, scenario.dock).warnings().empty());
+  calibration.cameras.erase(
+      std::remove_if(calibration.cameras.begin(), calibration.cameras.end(),
+                     [](const CameraCalibration& c) { return c.role != CameraRole::kStereoLeft; }),
+      calibration.cameras.end());
+  const PaperBaselinePipeline pipeline(calibration, scenario.dock);
+  ASSERT_EQ(pipeline.warnings().size(), 1u);
+  EXPECT_NE(pipeline.warnings()[0].find(calibration.cameras[0].name + " has role stereo_left"),
+            std::string::npos)
+      << pipeline.warnings()[0];
+}
+
 TEST(PaperBaselinePipelineTest, CrossbarAlongTheEpipolarLineKeepsItsIdentities) {
   const Scenario scenario = test::DefaultScenario();
   const Calibration calibration = MakeCalibration(scenario);

@@ -12,9 +12,11 @@
 //
 // Large scales are computed on a Gaussian pyramid (cv::pyrDown: each level blurs by ~1.1 px of
 // its own resolution): the residual blur sqrt(sigma^2 - sigma_pyr^2) is applied at the coarsest
-// level that still leaves it at least 1 pixel of that level, and the response is resampled to
-// full resolution (bilinear) for the comparison across scales. Cost on one core, 640 x 512:
-// ~2 ms for 7 scales.
+// level that still leaves it at least 1 pixel of that level. Spatial maxima are found on each
+// scale's own level (level pixel j is full-resolution pixel 2^level j: pyrDown's kernel is
+// centred on the even pixels) and compared with the neighbouring scales sampled bilinearly at the
+// same point; a coarse candidate's position is good to its level's pixel, and the core centroid
+// (light_core_centroid.h) refines it.
 //
 // Units: pixels (0, 0 is the centre of the top-left pixel) and gray levels.
 #pragma once

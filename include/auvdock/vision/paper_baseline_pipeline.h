@@ -139,6 +139,8 @@ class PaperBaselinePipeline {
   const CameraCalibration* left_camera() const { return left_; }
   const CameraCalibration* right_camera() const { return right_; }
   const CameraCalibration* mono_camera() const { return mono_; }
+  // What of the rig the pipeline cannot use, and why (a lone stereo camera), for the log.
+  const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
   // Identifies the detections of one image against the dock; returns the matcher's pose.
@@ -166,6 +168,7 @@ class PaperBaselinePipeline {
   const CameraCalibration* left_ = nullptr;
   const CameraCalibration* right_ = nullptr;
   const CameraCalibration* mono_ = nullptr;
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace auvdock
