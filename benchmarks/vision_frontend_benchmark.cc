@@ -70,11 +70,12 @@ void BM_Dehaze(benchmark::State& state) {
 }
 BENCHMARK(BM_Dehaze)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
 
-void BM_Detect(benchmark::State& state) {
+// Times detector.Detect on the stereo-left frame at the benchmark's resolution.
+template <typename Detector>
+void TimeDetection(const Detector& detector, benchmark::State& state) {
   cv::setNumThreads(1);
   const cv::Mat frame =
       RenderFrame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
-  const LightDetector detector;  // default options: no dehazing
   size_t lights = 0;
   for (auto _ : state) {
     const std::vector<LightDetection> detections = detector.Detect(frame);
@@ -84,24 +85,17 @@ void BM_Detect(benchmark::State& state) {
   state.counters["lights"] = static_cast<double>(lights);
   state.SetItemsProcessed(state.iterations() * frame.total());
 }
+
+void BM_Detect(benchmark::State& state) {
+  TimeDetection(LightDetector(), state);  // default options: no dehazing
+}
 BENCHMARK(BM_Detect)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
 
 // The real-water detector (blob_light_detector.h) on the same frame, with the dock's colour.
 void BM_DetectBlob(benchmark::State& state) {
-  cv::setNumThreads(1);
-  const cv::Mat frame =
-      RenderFrame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
   BlobLightDetectorOptions options;
   options.checks.colour = LightColour::kBlueGreen;
-  const BlobLightDetector detector(options);
-  size_t lights = 0;
-  for (auto _ : state) {
-    const std::vector<LightDetection> detections = detector.Detect(frame);
-    lights = detections.size();
-    benchmark::DoNotOptimize(detections.data());
-  }
-  state.counters["lights"] = static_cast<double>(lights);
-  state.SetItemsProcessed(state.iterations() * frame.total());
+  TimeDetection(BlobLightDetector(options), state);
 }
 BENCHMARK(BM_DetectBlob)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
 
