@@ -256,6 +256,7 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   State* state = window_.back().get();
   VisionFactorOptions vision = options_.vision;
   for (const auto& [id, scale] : mono_noise_) vision.mono_variance_factor[id] = scale.factor();
+  for (const auto& [id, scale] : stereo_noise_) vision.stereo_variance_factor[id] = scale.factor();
   state->vision = AddVisionFactors(problem_.get(), frame, rig_, vision, state->pose,
                                    &stats_.skipped_observations);
 
@@ -285,30 +286,30 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
 }
 
 void SlidingWindowEstimator::UpdateNoiseScales(const State& state, const Matrix6d& covariance) {
-  Eigen::Matrix<double, kPoseSize, kPoseTangentSize, Eigen::RowMajor> plus;
-  pose_manifold_->PlusJacobian(state.pose, plus.data());
   for (const VisionResidual& r : state.vision) {
-    // Mono only: for the stereo points the leverage computed this way came out far above the
-    // residual's dimension on the default scenario (not yet understood), so their noise is not
-    // adapted.
-    if (!r.mono) continue;
-    Eigen::Vector2d residual = Eigen::Vector2d::Zero();
-    Eigen::Matrix<double, 2, kPoseSize, Eigen::RowMajor> J;
-    double* jacobians[1] = {J.data()};
+    const int m = r.mono ? 2 : 3;
+    // Problem::EvaluateResidualBlock returns the Jacobian in the pose's tangent space (m x 6,
+    // row-major), the space of the covariance.
+    Eigen::Vector3d residual = Eigen::Vector3d::Zero();
+    Eigen::Matrix<double, 3, kPoseTangentSize, Eigen::RowMajor> J_buffer;
+    double* jacobians[1] = {J_buffer.data()};
     double cost = 0.0;
     if (!problem_->EvaluateResidualBlock(r.id, /*apply_loss_function=*/false, &cost,
                                          residual.data(), jacobians)) {
       continue;
     }
-    const Eigen::Matrix<double, 2, kPoseTangentSize> J_local = J * plus;
+    const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, kPoseTangentSize, Eigen::RowMajor>>
+        J(J_buffer.data(), m, kPoseTangentSize);
     // The residual's share of the fit: its stage weight times J P J^T (J whitened, unweighted).
-    const double leverage = r.weight * (J_local * covariance * J_local.transpose()).trace();
-    auto it = mono_noise_.find(r.light_id);
-    if (it == mono_noise_.end()) {
-      it = mono_noise_.emplace(r.light_id, AdaptiveNoiseScale(options_.adaptive_vision_noise)).first;
+    const double leverage = r.weight * (J * covariance * J.transpose()).trace();
+    auto& scales = r.mono ? mono_noise_ : stereo_noise_;
+    auto it = scales.find(r.light_id);
+    if (it == scales.end()) {
+      it = scales.emplace(r.light_id, AdaptiveNoiseScale(options_.adaptive_vision_noise)).first;
     }
-    it->second.Update(residual.squaredNorm(), std::clamp(2.0 - leverage, 0.0, 2.0));
-    stats_.mono_variance_factor[r.light_id] = it->second.factor();
+    it->second.Update(residual.head(m).squaredNorm(), std::clamp(m - leverage, 0.0, 1.0 * m));
+    (r.mono ? stats_.mono_variance_factor : stats_.stereo_variance_factor)[r.light_id] =
+        it->second.factor();
   }
 }
 

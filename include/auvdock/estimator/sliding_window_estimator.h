@@ -82,14 +82,14 @@ struct EstimatorOptions {
   double init_gyro_bias_sigma = 0.01;   // rad/s
   double init_accel_bias_sigma = 0.1;   // m/s^2
   bool compute_covariance = true;       // marginal covariance of the newest pose every frame
-  // Online variance factor of each light's mono pixels, from each frame's residuals after the
-  // solve and their leverage on the newest pose (adaptive_noise_scale.h; needs
-  // compute_covariance): larger-than-configured centroid errors widen that light's covariance,
-  // better ones narrow it, within the bounds. The stereo points are not adapted yet.
-  // Off by default: on white synthetic errors at the configured sigma the leverage computed
-  // from the reported newest-pose covariance comes out at ~1.9 of a pixel pair's 2 degrees of
-  // freedom while the residuals say ~0.7, so the factors settle at 1.4-2.1 instead of 1 and the
-  // covariance turns conservative (README, "Real water and any dock").
+  // Online variance factors of each light's mono pixels and stereo points, from each frame's
+  // residuals after the solve and their leverage on the newest pose (adaptive_noise_scale.h;
+  // needs compute_covariance): larger-than-configured centroid errors widen that light's
+  // covariance, better ones narrow it, within the bounds. On white synthetic errors at the
+  // configured sigma the factors stay within ~0.85-1.12. Off by default: on our renders they
+  // settle at the white part of the errors (~0.4 mono, the 0.25 bound stereo), and the window,
+  // which does not model the slowly varying part, then becomes overconfident (default scenario
+  // NEES 8.4 instead of 5.7; README, "Real water and any dock").
   AdaptiveNoiseOptions adaptive_vision_noise = AdaptiveNoiseOptions{/*enabled=*/false};
   // Batch smoother only (estimator/batch_smoother.h): the slowly varying part of the detection
   // errors, per pixel coordinate (1-sigma, px) and its correlation time (s); either 0 = white
@@ -174,7 +174,7 @@ class SlidingWindowEstimator {
   bool Solve();
   void MarginalizeOldest();
   EstimatorOutput Output(const State& state);
-  // The newest frame's mono residuals, with their leverage on the newest pose (its covariance
+  // The newest frame's vision residuals, with their leverage on the newest pose (its covariance
   // in the tangent space), into the adaptive noise factors of their lights.
   void UpdateNoiseScales(const State& state, const Matrix6d& covariance);
 
@@ -190,8 +190,9 @@ class SlidingWindowEstimator {
   int64_t last_frame_t_ns_ = INT64_MIN;
   int64_t last_vision_t_ns_ = INT64_MIN;
   EstimatorStats stats_;
-  // Per light id: the adaptive variance factor of its mono pixels.
+  // Per light id: the adaptive variance factors of its mono pixels and its stereo points.
   std::map<int, AdaptiveNoiseScale> mono_noise_;
+  std::map<int, AdaptiveNoiseScale> stereo_noise_;
 };
 
 }  // namespace auvdock
