@@ -32,6 +32,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "apps/commands.h"
+#include "apps/reason_class.h"
 #include "apps/signal_flag.h"
 #include "auvdock/eval/detection_evaluation.h"
 #include "auvdock/io/camera_file.h"
@@ -67,14 +68,6 @@ struct DetectOptions {
 };
 
 using Clock = std::chrono::steady_clock;
-
-// The class of a reason, for counting: its text up to the first number or detail.
-std::string ReasonClass(const std::string& reason) {
-  const size_t end = reason.find_first_of("0123456789{(");
-  std::string key = reason.substr(0, end);
-  while (!key.empty() && (key.back() == ' ' || key.back() == ',')) key.pop_back();
-  return key.empty() ? reason : key;
-}
 
 void DrawOverlay(const cv::Mat& image, const std::vector<LightDetection>& detections,
                  const std::vector<int>& ids, const std::vector<RejectedLightCandidate>& rejected,

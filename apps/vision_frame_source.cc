@@ -6,6 +6,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "apps/reason_class.h"
 #include "auvdock/estimator/vision_frame_builder.h"
 #include "auvdock/io/input_error.h"
 
@@ -86,12 +87,7 @@ std::optional<VisionFrame> VisionFrameSource::Next(const Predictor& predict) {
                                                 predict ? predict(t) : std::nullopt);
   VisionFrame vision = MakeVisionFrame(frame, cameras_[0], cameras_[1], cameras_[2]);
   if (vision.empty()) {
-    std::string reason = frame.reason.empty() ? "no identified light" : frame.reason;
-    // Counted by the reason's words, not its figures ("only 2 detections" ~ "only 3 ...").
-    const size_t detail = reason.find_first_of("0123456789({");
-    if (detail != std::string::npos && detail > 0) reason = reason.substr(0, detail);
-    while (!reason.empty() && (reason.back() == ' ' || reason.back() == ',')) reason.pop_back();
-    ++no_vision_reasons_[reason];
+    ++no_vision_reasons_[ReasonClass(frame.reason.empty() ? "no identified light" : frame.reason)];
   }
   decode_s_ += Seconds(t1 - t0);
   frontend_s_ += Seconds(Clock::now() - t1);

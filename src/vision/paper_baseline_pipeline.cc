@@ -63,6 +63,7 @@ std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& ca
   obs->light_ids.assign(obs->detections.size(), -1);
   MatchResult match;
   std::optional<Pose3> T_C_D;
+  const std::optional<Pose3> predicted_T_C_D = Predict(camera, t_ns);
   if (options_.matcher == BaselineMatcher::kOmnidirectional) {
     match = MatchOmnidirectional(obs->detections, dock_);
   } else {
@@ -70,7 +71,7 @@ std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& ca
     ransac.pixel_noise_px = camera.pixel_noise_px;
     // A symmetric dock's poses: the copy nearest the prediction, else the approach side.
     SymmetryHint hint;
-    hint.predicted_T_C_D = Predict(camera, t_ns);
+    hint.predicted_T_C_D = predicted_T_C_D;
     if (dock_.approach_direction_D.norm() > 0.0) {
       hint.approach_direction_D = dock_.approach_direction_D;
     }
@@ -80,7 +81,6 @@ std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& ca
     match = result;
     obs->symmetry = result.symmetry;
   }
-  const std::optional<Pose3> predicted_T_C_D = Predict(camera, t_ns);
   if (match.status != MatchStatus::kOk && predicted_T_C_D) {
     const MatchResult tracked = MatchByPrediction(obs->detections, dock_, camera.intrinsics,
                                                   *predicted_T_C_D, options_.tracking);

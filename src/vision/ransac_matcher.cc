@@ -542,15 +542,14 @@ Hypothesis ApplySymmetry(const Hypothesis& h, const DockSymmetry& s) {
   return out;
 }
 
-// One representative of h's symmetric copies (the lexicographically smallest labelling), so
-// that copies are the same hypothesis, not rivals.
-Hypothesis Canonical(const Hypothesis& h, const std::vector<DockSymmetry>& symmetries) {
-  Hypothesis best = h;
+// Replaces *h by one representative of its symmetric copies (the lexicographically smallest
+// labelling), so that copies are the same hypothesis, not rivals. Nothing to do (and no copy
+// made) for a dock without symmetry: this runs for every scored pose.
+void Canonicalize(const std::vector<DockSymmetry>& symmetries, Hypothesis* h) {
   for (size_t k = 1; k < symmetries.size(); ++k) {
-    Hypothesis copy = ApplySymmetry(h, symmetries[k]);
-    if (copy.detection_of_light < best.detection_of_light) best = std::move(copy);
+    Hypothesis copy = ApplySymmetry(*h, symmetries[k]);
+    if (copy.detection_of_light < h->detection_of_light) *h = std::move(copy);
   }
-  return best;
 }
 
 // Spread off the best line below this fraction of the spread along it: collinear.
@@ -785,7 +784,9 @@ RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, con
         }
         ++result.num_poses;
         best_inliers = std::max(best_inliers, scored.inliers);
-        if (scored.inliers >= pool_threshold) pool.Offer(Canonical(scored, symmetries));
+        if (scored.inliers < pool_threshold) continue;
+        Canonicalize(symmetries, &scored);
+        pool.Offer(scored);
       }
     }
     if (best_inliers >= explain_all) break;
@@ -796,7 +797,8 @@ RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, con
   const auto& kept = pool.hypotheses();
   for (size_t h = 0; h < kept.size() && static_cast<int>(h) < options.max_refined_hypotheses; ++h) {
     if (kept[h].inliers < kept.front().inliers - 1) break;
-    Hypothesis r = Canonical(Refine(scene, kept[h], options), symmetries);
+    Hypothesis r = Refine(scene, kept[h], options);
+    Canonicalize(symmetries, &r);
     if (!PlausiblePose(scene, r.pose, options)) continue;
     bool duplicate = false;
     for (Hypothesis& other : refined) {
