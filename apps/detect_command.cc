@@ -1,5 +1,6 @@
 // auvdock detect --images "DIR/*.jpg" --calib FILE [--camera NAME] --dock FILE --out DIR
-//                [--overlay] [--labels FILE] [--colour C] [--deinterlace] [--no-tracking]
+//                [--overlay] [--labels FILE [--label-max-range M]] [--colour C] [--deinterlace]
+//                [--no-tracking]
 //                [--gravity-camera X Y Z] [--min-halo-excess GRAY]
 //
 // A first look at one's own footage: the real-water light detector (BlobLightDetector), the
@@ -65,6 +66,7 @@ struct DetectOptions {
   bool quiet = false;
   std::vector<double> gravity_camera;
   double min_halo_excess = -1.0;  // < 0: learned from the identified lights
+  double label_max_range_m = -1.0;  // < 0: every ok label is required
 };
 
 using Clock = std::chrono::steady_clock;
@@ -268,7 +270,9 @@ void RunDetect(const DetectOptions& options) {
     std::printf("  no pose: %d x %s\n", count, reason.c_str());
   }
   if (labels) {
-    const DetectionEvaluation e = EvaluateDetections(*labels, evaluated);
+    DetectionEvaluationOptions evaluation_options;
+    if (options.label_max_range_m >= 0.0) evaluation_options.max_range_m = options.label_max_range_m;
+    const DetectionEvaluation e = EvaluateDetections(*labels, evaluated, evaluation_options);
     summary["labels"] = {{"file", options.labels},
                          {"frames", e.frames},
                          {"frames_not_processed", e.missing_frames},
@@ -280,6 +284,7 @@ void RunDetect(const DetectOptions& options) {
                          {"centroid_median_px", e.centroid_median_px},
                          {"centroid_samples", e.centroid_samples},
                          {"pose_frames_eligible", e.pose_frames_eligible},
+                         {"pose_frames", e.pose_frames},
                          {"pose_rate", e.pose_rate},
                          {"missed", e.missed},
                          {"false_detections", e.false_detections}};
@@ -312,6 +317,10 @@ void AddDetectCommand(CLI::App& root) {
   sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
   sub->add_option("--labels", options->labels,
                   "Hand labels (CSV: frame_file,u,v[,status,quality]): measure the detector");
+  sub->add_option("--label-max-range", options->label_max_range_m,
+                  "Require only labels nearer than this (m; labels with a range_m column, e.g. "
+                  "a simulated dataset's groundtruth/<camera>_lights.csv)")
+      ->check(CLI::NonNegativeNumber);
   sub->add_option("--colour", options->colour,
                   "Light colour (white, blue, green, blue_green, red); default: the dock's");
   sub->add_flag("--overlay", options->overlay, "Write each image with the detections drawn");

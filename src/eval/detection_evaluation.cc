@@ -49,6 +49,7 @@ DetectionEvaluation EvaluateDetections(const LightLabels& labels,
     for (size_t i = 0; i < frame_labels.size(); ++i) {
       const LightLabel& label = frame_labels[i];
       if (label.status != LabelStatus::kOk) continue;
+      if (label.range_m >= 0.0 && label.range_m > options.max_range_m) continue;
       ++ok_in_frame;
       ++e.ok_labels;
       const int j = detection_of_label[i];

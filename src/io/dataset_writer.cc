@@ -57,6 +57,32 @@ void DatasetWriter::AddVisibility(const VisibilityRecord& r) {
 }
 void DatasetWriter::AddFault(const FaultRecord& f) { faults_->Line(FaultCsvRow(f)); }
 
+void DatasetWriter::AddLightTruth(const std::string& camera, int64_t t_ns,
+                                      const std::vector<LightTruth>& lights, int width,
+                                      int height) {
+  std::unique_ptr<CsvWriter>& out = rendered_lights_[camera];
+  if (!out) {
+    out = std::make_unique<CsvWriter>(
+        (fs::path(root_) / "groundtruth" / (camera + "_lights.csv")).string(),
+        "frame_file,light_id,u,v,status,range_m,sigma_px,peak");
+  }
+  const std::string file = std::to_string(t_ns) + ".png";
+  if (lights.empty()) {
+    out->Line(file + ",,,,none,,,");
+    return;
+  }
+  for (const LightTruth& light : lights) {
+    const double margin = 3.0 * light.sigma_px + 1.0;
+    const bool inside = light.uv.x() >= margin - 0.5 && light.uv.y() >= margin - 0.5 &&
+                        light.uv.x() <= width - 0.5 - margin &&
+                        light.uv.y() <= height - 0.5 - margin;
+    out->Line(file + "," + std::to_string(light.light_id) + "," + FormatDouble(light.uv.x()) +
+              "," + FormatDouble(light.uv.y()) + "," + (inside ? "ok" : "border") + "," +
+              FormatDouble(light.range_m) + "," + FormatDouble(light.sigma_px) + "," +
+              FormatDouble(light.peak));
+  }
+}
+
 void DatasetWriter::AddGroundTruth(const GroundTruthState& s) {
   groundtruth_->Line(GroundTruthCsvRow(s));
   tum_->Append({s.t_ns, s.T_D_B});

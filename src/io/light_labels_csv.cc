@@ -58,7 +58,7 @@ LightLabels LoadLightLabels(const std::string& path) {
     }
     return std::vector<std::string>{};
   };
-  int col_file = -1, col_u = -1, col_v = -1, col_status = -1, col_quality = -1;
+  int col_file = -1, col_u = -1, col_v = -1, col_status = -1, col_quality = -1, col_range = -1;
   while (std::getline(in, line)) {
     ++line_number;
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
@@ -71,13 +71,14 @@ LightLabels LoadLightLabels(const std::string& path) {
       if (h == "v") col_v = c;
       if (h == "status") col_status = c;
       if (h == "quality") col_quality = c;
+      if (h == "range_m") col_range = c;
     }
     break;
   }
   if (col_file < 0 || col_u < 0 || col_v < 0) {
     fail("the first row must name the columns frame_file, u and v");
   }
-  const int needed = std::max({col_file, col_u, col_v, col_status, col_quality}) + 1;
+  const int needed = std::max({col_file, col_u, col_v, col_status, col_quality, col_range}) + 1;
   LightLabels labels;
   while (std::getline(in, line)) {
     ++line_number;
@@ -101,8 +102,7 @@ LightLabels LoadLightLabels(const std::string& path) {
     } else {
       fail("column 'status': '" + status + "' (ok, border, edge, none)");
     }
-    for (int axis = 0; axis < 2; ++axis) {
-      const int col = axis == 0 ? col_u : col_v;
+    auto number = [&](int col, const char* name) {
       size_t used = 0;
       double value = 0.0;
       try {
@@ -111,10 +111,14 @@ LightLabels LoadLightLabels(const std::string& path) {
         used = 0;
       }
       if (used == 0 || used != f[col].size() || !std::isfinite(value)) {
-        fail(std::string("column '") + (axis == 0 ? "u" : "v") + "': not a finite number ('" +
-             f[col] + "')");
+        fail(std::string("column '") + name + "': not a finite number ('" + f[col] + "')");
       }
-      label.uv[axis] = value;
+      return value;
+    };
+    label.uv = Eigen::Vector2d(number(col_u, "u"), number(col_v, "v"));
+    if (col_range >= 0 && !f[col_range].empty()) {
+      label.range_m = number(col_range, "range_m");
+      if (label.range_m < 0.0) fail("column 'range_m': negative");
     }
     label.good = col_quality < 0 || f[col_quality] == "good";
     frame.push_back(label);

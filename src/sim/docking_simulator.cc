@@ -20,8 +20,11 @@ DockingSimulator::DockingSimulator(const Scenario& scenario)
   const WaterModel water = WaterModel::ForType(scenario.water_type);
   RenderOptions render = scenario.render;
   if (!scenario.noise_enabled) render.noise_sigma = 0.0;  // a noise-free run has clean images
-  for (const auto& cam : calibration_.cameras) {
-    renderers_.emplace_back(cam, scenario.dock, water, render);
+  for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
+    std::mt19937_64 look_rng = MakeRandomStream(
+        scenario.seed, static_cast<uint64_t>(RandomStreamId::kRenderLookBase) + i);
+    renderers_.emplace_back(calibration_.cameras[i], scenario.dock, water, render,
+                            DrawRenderLook(scenario.randomize, scenario.dock, look_rng));
   }
 }
 
@@ -145,6 +148,12 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
         const auto& cam = calibration_.cameras[i];
         const RenderResult image = renderers_[i].Render(T_D_B * cam.T_B_C, camera_rngs[i]);
         writer.AddImage(cam.name, t, image.image);
+        std::vector<LightTruth> truth;
+        for (const RenderedLight& light : image.lights) {
+          truth.push_back({light.light_id, light.uv, light.range_m, light.radius_px, light.peak});
+        }
+        writer.AddLightTruth(cam.name, t, truth, cam.intrinsics.width(),
+                                 cam.intrinsics.height());
         for (const auto& d : image.distractors) {
           record_fault(FaultRecord{t, cam.name, d.kind, DistractorDetail(d)});
         }

@@ -6,6 +6,7 @@
 #include "auvdock/io/dock_io.h"
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/yaml_config.h"
+#include "auvdock/sim/random_stream.h"
 
 namespace fs = std::filesystem;
 
@@ -81,6 +82,18 @@ void ReadRender(const ConfigNode& n, RenderOptions* r) {
   r->particles_per_frame = n.GetNonNegative("particles_per_frame", r->particles_per_frame);
 }
 
+void ReadRandomization(const ConfigNode& n, RenderRandomization* r) {
+  r->enabled = n.GetBool("enabled", r->enabled);
+  r->light_appearance = n.GetBool("light_appearance", r->light_appearance);
+  r->asymmetric_lobes = n.GetBool("asymmetric_lobes", r->asymmetric_lobes);
+  r->dock_structures = n.GetBool("dock_structures", r->dock_structures);
+  r->backgrounds = n.GetBool("backgrounds", r->backgrounds);
+  r->blur = n.GetBool("blur", r->blur);
+  r->interlacing = n.GetBool("interlacing", r->interlacing);
+  r->jpeg = n.GetBool("jpeg", r->jpeg);
+  r->strong_distortion = n.GetBool("strong_distortion", r->strong_distortion);
+}
+
 double GetProbability(const ConfigNode& n, const std::string& key, double fallback) {
   const double p = n.GetNonNegative(key, fallback);
   if (p > 1.0) n.Fail(key, "a probability must lie in [0, 1]");
@@ -112,6 +125,7 @@ Scenario LoadScenario(const std::string& path) {
   ReadTrajectory(root.ChildOrEmpty("trajectory"), &s.trajectory);
   ReadCameras(root.ChildOrEmpty("cameras"), &s.cameras);
   ReadRender(root.ChildOrEmpty("render"), &s.render);
+  ReadRandomization(root.ChildOrEmpty("randomize"), &s.randomize);
 
   const ConfigNode imu = root.ChildOrEmpty("imu");
   s.imu.rate_hz = imu.GetPositive("rate_hz", s.imu.rate_hz);
@@ -176,18 +190,29 @@ Eigen::Quaterniond DownCameraRotation() {
 
 Calibration MakeCalibration(const Scenario& s) {
   const CameraRigConfig& c = s.cameras;
-  const PinholeRadtanCamera intrinsics =
-      PinholeRadtanCamera::FromHorizontalFov(c.width, c.height, c.hfov_deg * kDegToRad, c.distortion);
+  // Each camera's lens: the configured distortion, or one drawn per camera.
+  auto intrinsics_of = [&](int camera_index) {
+    std::array<double, 5> distortion = c.distortion;
+    if (s.randomize.enabled && s.randomize.strong_distortion) {
+      const double half_width = std::tan(0.5 * c.hfov_deg * kDegToRad);
+      const double corner = half_width * std::hypot(1.0, static_cast<double>(c.height) / c.width);
+      std::mt19937_64 rng = MakeRandomStream(
+          s.seed, static_cast<uint64_t>(RandomStreamId::kLensBase) + camera_index);
+      distortion = DrawStrongDistortion(corner, rng);
+    }
+    return PinholeRadtanCamera::FromHorizontalFov(c.width, c.height, c.hfov_deg * kDegToRad,
+                                                  distortion);
+  };
   Calibration cal;
   const Eigen::Quaterniond q_stereo = ForwardDownCameraRotation(c.stereo_tilt_deg * kDegToRad);
   const Eigen::Vector3d half_baseline(0.0, 0.5 * c.stereo_baseline_m, 0.0);
-  cal.cameras.push_back({"cam0", CameraRole::kStereoLeft, intrinsics,
+  cal.cameras.push_back({"cam0", CameraRole::kStereoLeft, intrinsics_of(0),
                          Pose3(q_stereo, c.stereo_p_B - half_baseline), c.rate_hz,
                          c.pixel_noise_px});
-  cal.cameras.push_back({"cam1", CameraRole::kStereoRight, intrinsics,
+  cal.cameras.push_back({"cam1", CameraRole::kStereoRight, intrinsics_of(1),
                          Pose3(q_stereo, c.stereo_p_B + half_baseline), c.rate_hz,
                          c.pixel_noise_px});
-  cal.cameras.push_back({"cam2", CameraRole::kMono, intrinsics,
+  cal.cameras.push_back({"cam2", CameraRole::kMono, intrinsics_of(2),
                          Pose3(DownCameraRotation(), c.mono_p_B), c.rate_hz, c.pixel_noise_px});
   cal.imu = s.imu;
   cal.depth = s.depth;

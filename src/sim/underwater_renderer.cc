@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "auvdock/sim/image_degradation.h"
+
 namespace auvdock {
 namespace {
 
@@ -41,8 +43,6 @@ constexpr double kMinSigmaPx = 0.8;
 constexpr double kMinLightDepthM = 0.05;
 // Luma weights (ITU-R BT.601, as cv::cvtColor uses), B G R.
 const Eigen::Vector3d kLumaBgr(0.114, 0.587, 0.299);
-// Cyan-green guide light (LEDs around 500 nm), B G R, relative.
-const Eigen::Vector3d kLightColourBgr(0.85, 1.0, 0.2);
 // Lamp-lit marine snow is whitish.
 const Eigen::Vector3d kParticleColourBgr(1.0, 1.0, 0.85);
 // Sand/mud is slightly warmer than grey, B G R.
@@ -52,7 +52,6 @@ const Eigen::Vector3f kSeabedTintBgr(0.85f, 1.0f, 1.1f);
 // light core dark and flat, so clipping does not pull the intensity centroid along the lamp's
 // brightness gradient on the deck.
 constexpr double kHousingRadiusFactor = 4.0;
-constexpr float kHousingAlbedo = 0.04f;
 // The lamp irradiance 1/r^2 is capped at this range (m) so a surface touching the camera stays
 // finite.
 constexpr float kMinLampRangeM = 0.5f;
@@ -174,11 +173,57 @@ void AddGaussianBlob(const Eigen::Vector2d& uv, double sigma, const Eigen::Vecto
   }
 }
 
+// Adds amplitude_bgr * exp(-du^2 / (2 sigma^2)) * exp(-|dv| / (40 sigma)) over whole columns
+// around uv: a bloom smear, symmetric about the light so its centroid stays put.
+void AddVerticalSmear(const Eigen::Vector2d& uv, double sigma, const Eigen::Vector3d& amplitude_bgr,
+                      cv::Mat* image) {
+  const int u0 = std::max(0, static_cast<int>(std::ceil(uv.x() - 3.0 * sigma)));
+  const int u1 = std::min(image->cols - 1, static_cast<int>(std::floor(uv.x() + 3.0 * sigma)));
+  for (int v = 0; v < image->rows; ++v) {
+    const double wv = std::exp(-std::fabs(v - uv.y()) / (40.0 * sigma));
+    float* row = image->ptr<float>(v);
+    for (int u = u0; u <= u1; ++u) {
+      const double du = u - uv.x();
+      const double w = wv * std::exp(-du * du / (2.0 * sigma * sigma));
+      for (int ch = 0; ch < 3; ++ch) row[3 * u + ch] += static_cast<float>(w * amplitude_bgr[ch]);
+    }
+  }
+}
+
+// The first painted feature (render_look.h) covering (x, y) of the deck sets the albedo and the
+// post-knee gain; elsewhere they are left as they are.
+void PaintedFeature(const std::vector<DeckFeature>& features, float x, float y,
+                    Eigen::Vector3f* albedo, float* gain) {
+  for (const DeckFeature& f : features) {
+    const double px = x - f.a.x(), py = y - f.a.y();
+    bool inside = false;
+    if (f.kind == DeckFeature::Kind::kDisc) {
+      const double r2 = px * px + py * py;
+      inside = r2 <= f.radius_m * f.radius_m && r2 >= f.inner_radius_m * f.inner_radius_m;
+    } else {
+      const Eigen::Vector2d d = f.b - f.a;
+      const double t = std::clamp((px * d.x() + py * d.y()) / d.squaredNorm(), 0.0, 1.0);
+      const double ex = px - t * d.x(), ey = py - t * d.y();
+      inside = ex * ex + ey * ey <= f.radius_m * f.radius_m;
+    }
+    if (inside) {
+      *albedo = Eigen::Vector3f::Constant(static_cast<float>(f.albedo));
+      *gain = static_cast<float>(f.gain);
+      return;
+    }
+  }
+}
+
 }  // namespace
 
 UnderwaterRenderer::UnderwaterRenderer(const CameraCalibration& camera, const DockModel& dock,
                                        const WaterModel& water, const RenderOptions& options)
-    : camera_(camera), dock_(dock), water_(water), options_(options) {
+    : UnderwaterRenderer(camera, dock, water, options, DefaultRenderLook(dock)) {}
+
+UnderwaterRenderer::UnderwaterRenderer(const CameraCalibration& camera, const DockModel& dock,
+                                       const WaterModel& water, const RenderOptions& options,
+                                       const RenderLook& look)
+    : camera_(camera), dock_(dock), water_(water), options_(options), look_(look) {
   const PinholeRadtanCamera& intrinsics = camera_.intrinsics;
   const int width = intrinsics.width();
   const int height = intrinsics.height();
@@ -227,16 +272,23 @@ UnderwaterRenderer::UnderwaterRenderer(const CameraCalibration& camera, const Do
     for (int ch = 0; ch < 3; ++ch) transmission_table_[3 * i + ch] = static_cast<float>(t[ch]);
   }
 
+  // The look scales the waves, shifts their phases and adds a fine grain (pebbles): one uniform
+  // draw per texel, mean zero, clamped so the albedo stays positive.
   seabed_texture_.resize(kTextureSize * kTextureSize);
+  std::mt19937_64 grain_rng(look_.texture_seed);
   for (int j = 0; j < kTextureSize; ++j) {
     for (int i = 0; i < kTextureSize; ++i) {
       double value = 1.0;
       for (const TextureWave& wave : kTextureWaves) {
         const double phase =
             2.0 * kPi * (wave.nx * i + wave.ny * j) / static_cast<double>(kTextureSize);
-        value += wave.amplitude * std::sin(phase + wave.phase);
+        value += look_.texture_amplitude_scale * wave.amplitude *
+                 std::sin(phase + wave.phase + look_.texture_phase_offset);
       }
-      seabed_texture_[j * kTextureSize + i] = static_cast<float>(value);
+      if (look_.texture_grain > 0.0) {
+        value += look_.texture_grain * (2.0 * Uniform01(grain_rng) - 1.0);
+      }
+      seabed_texture_[j * kTextureSize + i] = static_cast<float>(std::max(0.05, value));
     }
   }
 }
@@ -249,12 +301,14 @@ double UnderwaterRenderer::Vignette(double cos_theta) const {
 Eigen::Vector3d UnderwaterRenderer::LightAmplitude(const DockLight& light, double range_m,
                                                    double cos_theta) const {
   // Share of the emitter's core that survives the optics' blur: ~1 while the disc is resolved.
-  const double radius_px = camera_.intrinsics.fx() * light.radius_m / range_m;
+  const double radius_px =
+      camera_.intrinsics.fx() * light.radius_m * look_.light_size_scale / range_m;
   const double blur_share =
       1.0 - std::exp(-radius_px * radius_px / (2.0 * kMinSigmaPx * kMinSigmaPx));
   const double gain = kFullScale * options_.exposure * Vignette(cos_theta) *
-                      options_.light_radiance * light.intensity * blur_share;
-  return gain * kLightColourBgr.cwiseProduct(water_.Transmission(range_m));
+                      options_.light_radiance * look_.light_radiance_scale * light.intensity *
+                      blur_share;
+  return gain * look_.light_colour_bgr.cwiseProduct(water_.Transmission(range_m));
 }
 
 inline float UnderwaterRenderer::SeabedTexture(float x_D, float y_D) const {
@@ -299,7 +353,8 @@ std::vector<RenderedLight> UnderwaterRenderer::VisibleLights(const Pose3& T_D_C)
     RenderedLight rendered;
     rendered.light_id = light.id;
     rendered.uv = *uv;
-    rendered.radius_px = std::max(kMinSigmaPx, intrinsics.fx() * light.radius_m / range);
+    rendered.radius_px = std::max(
+        kMinSigmaPx, intrinsics.fx() * light.radius_m * look_.light_size_scale / range);
     rendered.peak = peak;
     rendered.range_m = range;
     visible.push_back(rendered);
@@ -318,9 +373,9 @@ void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) co
   const float seabed_z = static_cast<float>(dock_.deck_height_m);
   const Eigen::Vector3f A = water_.veiling_light.cast<float>();
   const Eigen::Vector3f ambient = static_cast<float>(options_.ambient_light) * A;
-  const float lamp = static_cast<float>(options_.lamp_power);
+  const float lamp = static_cast<float>(options_.lamp_power * look_.lamp_power_scale);
   const Eigen::Vector3f deck_albedo =
-      Eigen::Vector3f::Constant(static_cast<float>(options_.deck_albedo));
+      Eigen::Vector3f::Constant(static_cast<float>(options_.deck_albedo * look_.deck_albedo_scale));
   const Eigen::Vector3f seabed_albedo = static_cast<float>(options_.seabed_albedo) * kSeabedTintBgr;
   // Beyond this range every channel's transmission is below 1e-4: the pixel is veiling light.
   const float max_range = static_cast<float>(max_surface_range_m_);
@@ -345,7 +400,9 @@ void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) co
     }
     housings.push_back({x, y, radius * radius});
   }
-  const Eigen::Vector3f housing_albedo = Eigen::Vector3f::Constant(kHousingAlbedo);
+  const Eigen::Vector3f housing_albedo =
+      Eigen::Vector3f::Constant(static_cast<float>(look_.housing_albedo));
+  const std::vector<DeckFeature>& features = look_.deck_features;
 
   const float* ray = pixel_rays_.data();
   float* out = image->ptr<float>(0);
@@ -356,6 +413,7 @@ void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) co
     const float dz = R_D_C(2, 0) * rx + R_D_C(2, 1) * ry + R_D_C(2, 2) * rz;
 
     float range = -1.0f;
+    float surface_gain = 1.0f;
     Eigen::Vector3f albedo;
     if (dz > 0.0f) {  // looking down (+z of D)
       if (oz < 0.0f) {
@@ -365,14 +423,19 @@ void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) co
         if (std::fabs(x) <= half_length && std::fabs(y) <= half_width && s < max_range) {
           range = s;
           albedo = deck_albedo;
+          bool in_housing = false;
           if (x >= box_min_x && x <= box_max_x && y >= box_min_y && y <= box_max_y) {
             for (const Housing& housing : housings) {
               const float hx = x - housing.x, hy = y - housing.y;
               if (hx * hx + hy * hy <= housing.radius2) {
                 albedo = housing_albedo;
+                in_housing = true;
                 break;
               }
             }
+          }
+          if (!in_housing && !features.empty()) {
+            PaintedFeature(features, x, y, &albedo, &surface_gain);
           }
         }
       }
@@ -400,8 +463,48 @@ void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) co
     for (int ch = 0; ch < 3; ++ch) {
       const float t = t0[ch] + alpha * (t0[ch + 3] - t0[ch]);
       const float J = albedo[ch] * (ambient[ch] + lamp_term * t);
-      out[ch] = RoundLevel(SoftKnee(gain * (J * t + A[ch] * (1.0f - t))));
+      out[ch] = RoundLevel(surface_gain * SoftKnee(gain * (J * t + A[ch] * (1.0f - t))));
     }
+  }
+}
+
+void UnderwaterRenderer::DrawLight(const RenderedLight& rendered, const Pose3& T_C_D,
+                                   cv::Mat* image) const {
+  // VisibleLights reported the luma of this amplitude; the blob needs the colour channels.
+  const DockLight* light = dock_.FindLight(rendered.light_id);
+  const Eigen::Vector3d p_C = T_C_D * light->p_D;
+  const Eigen::Vector3d amplitude = LightAmplitude(*light, rendered.range_m, p_C.z() / p_C.norm());
+  const double sigma = rendered.radius_px;
+  AddGaussianBlob(rendered.uv, sigma, amplitude, image);
+
+  // Off-axis lobe (render_look.h): towards the image of the light's tilt direction, displaced so
+  // that the unsaturated centroid moves by bias_px times the view factor.
+  const LightLobe* lobe = look_.FindLobe(light->id);
+  if (lobe != nullptr && lobe->amplitude_fraction > 0.0) {
+    const auto tip =
+        camera_.intrinsics.Project(T_C_D * (light->p_D + 0.01 * lobe->tilt_D), kMinLightDepthM);
+    if (tip && (*tip - rendered.uv).norm() > 1e-9) {
+      const Eigen::Vector3d normal_C = T_C_D.R() * Eigen::Vector3d(0.0, 0.0, -1.0);
+      const double cos_view = std::fabs(p_C.normalized().dot(normal_C));
+      const double view = std::max(0.3, std::sqrt(std::max(0.0, 1.0 - cos_view * cos_view)));
+      const double f = lobe->amplitude_fraction;
+      const double offset = lobe->bias_px * view * (1.0 + f) / f;
+      AddGaussianBlob(rendered.uv + offset * (*tip - rendered.uv).normalized(), sigma,
+                      f * amplitude, image);
+    }
+  }
+  // Forward scattering in the water: a wide, faint halo carrying a fraction of the core's
+  // energy (amplitude x sigma^2), so its peak is that fraction / halo_sigma_factor^2.
+  if (look_.halo_energy_fraction > 0.0) {
+    const double k = look_.halo_sigma_factor;
+    AddGaussianBlob(rendered.uv, sigma * k, look_.halo_energy_fraction / (k * k) * amplitude,
+                    image);
+  }
+  // Sensor bloom: the charge of a saturated core smears along its columns, symmetric about it.
+  const double excess = rendered.peak - kFullScale;
+  if (look_.bloom_fraction > 0.0 && excess > 0.0) {
+    const double level = std::min(60.0, look_.bloom_fraction * excess);
+    AddVerticalSmear(rendered.uv, sigma, level * amplitude / amplitude.maxCoeff(), image);
   }
 }
 
@@ -416,22 +519,23 @@ RenderResult UnderwaterRenderer::Render(const Pose3& T_D_C, std::mt19937_64& rng
   result.lights = VisibleLights(T_D_C);
   const Pose3 T_C_D = T_D_C.Inverse();
   for (const RenderedLight& rendered : result.lights) {
-    // VisibleLights reported the luma of this amplitude; the blob needs the colour channels.
-    const DockLight* light = dock_.FindLight(rendered.light_id);
-    const Eigen::Vector3d p_C = T_C_D * light->p_D;
-    const Eigen::Vector3d amplitude =
-        LightAmplitude(*light, rendered.range_m, p_C.z() / p_C.norm());
-    AddGaussianBlob(rendered.uv, rendered.radius_px, amplitude, &image);
-
+    DrawLight(rendered, T_C_D, &image);
     if (options_.reflections) {
       // Glint on the wet deck / camera port: dimmer, wider, below the light in the image.
+      const DockLight* light = dock_.FindLight(rendered.light_id);
+      const Eigen::Vector3d p_C = T_C_D * light->p_D;
+      const Eigen::Vector3d amplitude =
+          LightAmplitude(*light, rendered.range_m, p_C.z() / p_C.norm());
       const double sigma = rendered.radius_px;
-      const double fraction = Uniform(rng, 0.10, 0.25);
+      const double fraction =
+          Uniform(rng, look_.reflection_fraction_min, look_.reflection_fraction_max);
       const double jitter_u = 0.3 * sigma * StandardNormal(rng);
       const double jitter_v = 0.3 * sigma * StandardNormal(rng);
       RenderedDistractor reflection;
       reflection.kind = "reflection";
-      reflection.uv = rendered.uv + Eigen::Vector2d(jitter_u, 3.0 * sigma + 3.0 + jitter_v);
+      reflection.uv = rendered.uv + Eigen::Vector2d(jitter_u, look_.reflection_offset_sigmas * sigma +
+                                                                  look_.reflection_offset_px +
+                                                                  jitter_v);
       reflection.radius_px = 1.6 * sigma;
       if (intrinsics.InImage(reflection.uv)) {
         AddGaussianBlob(reflection.uv, reflection.radius_px, fraction * amplitude, &image);
@@ -440,7 +544,8 @@ RenderResult UnderwaterRenderer::Render(const Pose3& T_D_C, std::mt19937_64& rng
     }
   }
 
-  const int num_particles = Poisson(rng, options_.particles_per_frame);
+  const int num_particles =
+      Poisson(rng, options_.particles_per_frame * look_.particle_rate_scale);
   for (int i = 0; i < num_particles; ++i) {
     RenderedDistractor particle;
     particle.kind = "particle";
@@ -452,13 +557,20 @@ RenderResult UnderwaterRenderer::Render(const Pose3& T_D_C, std::mt19937_64& rng
     result.distractors.push_back(particle);
   }
 
-  if (options_.noise_sigma > 0.0) {
+  // The camera and the video chain (nothing with the default look; no draws either).
+  const FrameDegradation frame = DrawFrameDegradation(look_, rng);
+  ApplyOpticsAndFields(look_, frame, &image);
+  ApplyColourCast(look_, &image);
+  const double noise_sigma = options_.noise_sigma * look_.noise_sigma_scale;
+  if (noise_sigma > 0.0) {
     cv::RNG noise_rng(static_cast<uint64_t>(rng()));
     cv::Mat noise(height, width, CV_32FC3);
-    noise_rng.fill(noise, cv::RNG::NORMAL, 0.0, options_.noise_sigma);
+    noise_rng.fill(noise, cv::RNG::NORMAL, 0.0, noise_sigma);
     image += noise;
   }
-  image.convertTo(result.image, CV_8UC3);  // rounds to nearest and clips to [0, 255]
+  cv::Mat quantised;
+  image.convertTo(quantised, CV_8UC3);  // rounds to nearest and clips to [0, 255]
+  result.image = ApplyJpeg(frame, quantised);
   return result;
 }
 

@@ -33,6 +33,31 @@ TEST(LoadLightLabels, ReadsQuotedFieldsStatusesAndEmptyFrames) {
   EXPECT_FALSE(labels.at("c.jpg")[0].good);
 }
 
+TEST(EvaluateDetections, LabelsBeyondTheMaximumRangeAreNotRequired) {
+  test::TempDir dir;
+  test::WriteTextFile(dir / "l.csv",
+                      "frame_file,light_id,u,v,status,range_m\n"
+                      "a.png,0,10,10,ok,3.5\n"
+                      "a.png,1,50,10,ok,9.0\n"
+                      "a.png,2,90,10,ok,\n");
+  const LightLabels labels = LoadLightLabels(dir / "l.csv");
+  EXPECT_DOUBLE_EQ(labels.at("a.png")[0].range_m, 3.5);
+  EXPECT_LT(labels.at("a.png")[2].range_m, 0.0);  // unknown
+  std::map<std::string, FrameDetections> frames;
+  frames["a.png"].uv = {Eigen::Vector2d(10.5, 10.0), Eigen::Vector2d(50.0, 10.5)};
+  DetectionEvaluationOptions options;
+  const DetectionEvaluation all = EvaluateDetections(labels, frames, options);
+  EXPECT_EQ(all.ok_labels, 3);
+  EXPECT_EQ(all.hits, 2);
+  options.max_range_m = 8.0;
+  const DetectionEvaluation near = EvaluateDetections(labels, frames, options);
+  EXPECT_EQ(near.ok_labels, 2);  // the 9 m light is not required; the one of unknown range is
+  EXPECT_EQ(near.hits, 1);
+  EXPECT_DOUBLE_EQ(near.precision, 1.0);  // the far light's detection is still a hit
+  test::WriteTextFile(dir / "bad.csv", "frame_file,u,v,range_m\na.png,1,2,-3\n");
+  EXPECT_THROW(LoadLightLabels(dir / "bad.csv"), InputError);
+}
+
 TEST(LoadLightLabels, MinimalColumnsDefaultToOkAndGood) {
   test::TempDir dir;
   test::WriteTextFile(dir / "l.csv", "u,v,frame_file\n3,4,x.png\n");

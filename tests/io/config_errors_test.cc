@@ -45,6 +45,20 @@ TEST_F(ScenarioErrors, MinimalScenarioLoadsWithDefaults) {
   EXPECT_DOUBLE_EQ(s.imu.rate_hz, 200.0);
 }
 
+TEST_F(ScenarioErrors, RandomizeSectionIsOffByDefaultAndChecked) {
+  EXPECT_FALSE(LoadScenario(WriteScenario("dock: ../docks/t_shape.yaml\n")).randomize.enabled);
+  const Scenario s = LoadScenario(
+      WriteScenario("dock: ../docks/t_shape.yaml\nrandomize: {enabled: true, jpeg: false}\n"));
+  EXPECT_TRUE(s.randomize.enabled);
+  EXPECT_FALSE(s.randomize.jpeg);
+  EXPECT_TRUE(s.randomize.blur);
+  const std::string path =
+      WriteScenario("dock: ../docks/t_shape.yaml\nrandomize: {enabled: true, blurr: false}\n");
+  EXPECT_THAT(ErrorOf([&] { LoadScenario(path); }),
+              AllOf(HasSubstr(path), HasSubstr("randomize.blurr"), HasSubstr("unknown")));
+  EXPECT_NO_THROW(LoadScenario(test::SourcePath("data/scenarios/randomized.yaml")));
+}
+
 TEST_F(ScenarioErrors, UnknownKeyIsNamedWithItsPath) {
   const std::string path =
       WriteScenario("dock: ../docks/t_shape.yaml\ncameras:\n  stereo: {tilt_dgr: 30}\n");

@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include "auvdock/io/calibration.h"
 #include "auvdock/io/dataset.h"
+#include "auvdock/io/light_labels_csv.h"
 #include "tests/testing/temp_dir.h"
 #include "tests/testing/test_scenarios.h"
 
@@ -39,6 +41,48 @@ TEST(DockingSimulator, SameSeedGivesByteIdenticalOutputAndOtherSeedsDiffer) {
   EXPECT_NE(a.at("imu0/data.csv"), c.at("imu0/data.csv"));
   EXPECT_NE(a.at("cam0/data/1700000000000000000.png"), c.at("cam0/data/1700000000000000000.png"));
   EXPECT_EQ(a.at("groundtruth.tum"), c.at("groundtruth.tum"));  // the trajectory is the scenario's
+}
+
+TEST(DockingSimulator, WritesTheLightsOfEveryImageAsLabels) {
+  test::TempDir tmp;
+  const Scenario scenario = test::ShortScenario(1.0);
+  const DockingSimulator simulator(scenario);
+  simulator.Run(tmp.path(), CancellationToken());
+  for (const CameraCalibration& camera : simulator.calibration().cameras) {
+    const LightLabels labels = LoadLightLabels(tmp / ("groundtruth/" + camera.name + "_lights.csv"));
+    ASSERT_EQ(labels.size(), 11u) << camera.name;  // every frame, with or without lights
+    for (const auto& [file, frame_labels] : labels) {
+      const int64_t t_ns = std::stoll(file.substr(0, file.find('.')));
+      const Pose3 T_D_C = simulator.CameraPose(camera, t_ns);
+      ASSERT_TRUE(fs::exists(tmp / (camera.name + "/data/" + file)));
+      for (const LightLabel& label : frame_labels) {
+        EXPECT_GT(label.range_m, 0.0);
+        // The label is the light's projection: some dock light projects there at that range.
+        double best = 1e9;
+        for (const DockLight& light : scenario.dock.lights) {
+          const auto uv = camera.intrinsics.Project(T_D_C.Inverse() * light.p_D);
+          if (uv) best = std::min(best, (*uv - label.uv).norm());
+        }
+        EXPECT_LT(best, 1e-6);
+      }
+    }
+  }
+}
+
+TEST(DockingSimulator, RandomisedLooksDifferPerCameraAndTheLensIsInTheCalibration) {
+  test::TempDir tmp;
+  Scenario scenario = test::ShortScenario(0.2);
+  scenario.randomize.enabled = true;
+  const DockingSimulator simulator(scenario);
+  const auto& cameras = simulator.calibration().cameras;
+  EXPECT_NE(cameras[0].intrinsics.distortion(), cameras[1].intrinsics.distortion());
+  EXPECT_LE(cameras[0].intrinsics.distortion()[0], -0.1);
+  simulator.Run(tmp.path(), CancellationToken());
+  const Calibration written = LoadCalibration(tmp / "calibration.yaml");
+  EXPECT_EQ(written.cameras[2].intrinsics.distortion(), cameras[2].intrinsics.distortion());
+  scenario.randomize.strong_distortion = false;
+  EXPECT_EQ(DockingSimulator(scenario).calibration().cameras[0].intrinsics.distortion(),
+            scenario.cameras.distortion);
 }
 
 TEST(DockingSimulator, WritesEverySensorAtItsRate) {

@@ -2,7 +2,9 @@
 //
 // Per labelled frame: detections and labels within hit_radius_px are paired greedily, nearest
 // pair first (each used once). Then
-//   recall     = hits on `ok` labels / `ok` labels;
+//   recall     = hits on `ok` labels / `ok` labels (an `ok` label farther than max_range_m, when
+//                its range is known, is not required: a detection of it is a hit, as for
+//                `border`);
 //   precision  = detections paired with any label / detections, where detections not paired
 //                but within edge_radius_px of an `edge` label are left out of both counts;
 //   centroid   = RMS of |detection - label| over hits on `ok` labels of quality good (pixels);
@@ -10,6 +12,7 @@
 // Only the labelled frames count.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -24,6 +27,7 @@ struct DetectionEvaluationOptions {
   double hit_radius_px = 10.0;
   double edge_radius_px = 15.0;
   int min_lights_for_pose = 4;
+  double max_range_m = std::numeric_limits<double>::infinity();
 };
 
 struct FrameDetections {

@@ -5,6 +5,7 @@
 
 #include <map>
 #include <memory>
+#include <vector>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -29,6 +30,12 @@ class DatasetWriter {
   void AddAcoustic(const AcousticFix& m);
   // Writes <camera>/data/<t_ns>.png (lossless, 8-bit) and its data.csv row.
   void AddImage(const std::string& camera, int64_t t_ns, const cv::Mat& image);
+  // Appends the lights drawn in one rendered image to groundtruth/<camera>_lights.csv, in the
+  // hand-label format (io/light_labels_csv.h) that `auvdock detect --labels` reads: status `ok`
+  // when the blob lies 3 sigma + 1 px inside the image, `border` otherwise; a frame without a
+  // light gets one row with status `none`.
+  void AddLightTruth(const std::string& camera, int64_t t_ns,
+                         const std::vector<LightTruth>& lights, int width, int height);
   void AddGroundTruth(const GroundTruthState& s);  // also appends to groundtruth.tum
   void AddVisibility(const VisibilityRecord& r);
   void AddFault(const FaultRecord& f);
@@ -41,6 +48,7 @@ class DatasetWriter {
   std::unique_ptr<CsvWriter> imu_, depth_, dvl_, acoustic_, groundtruth_, visibility_, faults_;
   std::unique_ptr<TumWriter> tum_;
   std::map<std::string, std::unique_ptr<CsvWriter>> cameras_;
+  std::map<std::string, std::unique_ptr<CsvWriter>> rendered_lights_;
 };
 
 }  // namespace auvdock

@@ -2,7 +2,8 @@
 //
 // Format: CSV with a first row naming the columns; required `frame_file` (the image's file name,
 // without folder), `u`, `v` (pixels in the raw image, (0, 0) the centre of the top-left pixel);
-// optional `status` and `quality`; other columns are ignored. Fields may be double-quoted (a
+// optional `status`, `quality` and `range_m` (the light's distance from the camera, when known:
+// the simulator's ground truth has it); other columns are ignored. Fields may be double-quoted (a
 // quote inside is doubled). A row with empty u and v, or status `none`, says the frame was
 // labelled and shows no light.
 //   status:  ok (required: the light and its glow are inside the image; the default),
@@ -28,6 +29,7 @@ struct LightLabel {
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();
   LabelStatus status = LabelStatus::kOk;
   bool good = true;  // quality "good"
+  double range_m = -1.0;  // < 0: not known
 };
 
 // Every labelled frame (by file name), with its lights (possibly none).

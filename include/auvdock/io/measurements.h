@@ -73,6 +73,15 @@ struct VisibilityRecord {
   VisibilityStage stage = VisibilityStage::kUnknown;
 };
 
+// Where a light truly is in one camera image (the simulator's ground truth for a detector).
+struct LightTruth {
+  int light_id = 0;
+  Eigen::Vector2d uv = Eigen::Vector2d::Zero();  // distorted projection of the light's centre
+  double range_m = 0.0;
+  double sigma_px = 0.0;  // drawn blob's sigma
+  double peak = 0.0;      // luma amplitude above the background, gray levels (> 255: saturated)
+};
+
 struct FaultRecord {
   int64_t t_ns = 0;
   std::string sensor;  // e.g. "dvl0", "usbl0", "cam2"

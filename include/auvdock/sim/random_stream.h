@@ -19,7 +19,9 @@ enum class RandomStreamId : uint64_t {
   kDepth = 2,
   kDvl = 3,
   kAcoustic = 4,
+  kLensBase = 50,         // + camera index: the randomised distortion
   kCameraBase = 100,  // + camera index
+  kRenderLookBase = 200,  // + camera index: the randomised look
 };
 
 std::mt19937_64 MakeRandomStream(uint64_t seed, uint64_t stream_id);

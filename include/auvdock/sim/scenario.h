@@ -15,6 +15,7 @@
 #include "auvdock/sim/acoustic_simulator.h"
 #include "auvdock/sim/docking_trajectory.h"
 #include "auvdock/sim/dvl_simulator.h"
+#include "auvdock/sim/render_look.h"
 #include "auvdock/sim/underwater_renderer.h"
 #include "auvdock/sim/water_model.h"
 
@@ -48,6 +49,7 @@ struct Scenario {
   CameraRigConfig cameras;
   WaterType water_type = WaterType::kCoastal;
   RenderOptions render;
+  RenderRandomization randomize;  // the images' domain randomisation, off by default
 
   ImuCalibration imu;
   Eigen::Vector3d initial_gyro_bias = Eigen::Vector3d(0.002, -0.001, 0.0015);   // rad/s
@@ -63,7 +65,8 @@ struct Scenario {
 // Throws InputError naming the file and key.
 Scenario LoadScenario(const std::string& path);
 
-// The calibration of the simulated rig (what the dataset's calibration.yaml holds).
+// The calibration of the simulated rig (what the dataset's calibration.yaml holds). With
+// randomize.strong_distortion, each camera's distortion is drawn from the seed (render_look.h).
 Calibration MakeCalibration(const Scenario& scenario);
 
 }  // namespace auvdock

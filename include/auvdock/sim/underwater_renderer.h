@@ -41,6 +41,15 @@
 // position) are added as distractors, then additive Gaussian sensor noise, then rounding and
 // clipping to 8 bit.
 //
+// The look (render_look.h) sets what is not geometry or water: the lights' tint, size, radiance,
+// halo, bloom and asymmetric lobes, the deck's albedo, painted structures (a white funnel, rim,
+// cables, fittings; their gain applies after the knee, so they can saturate), the housings, the
+// seabed texture, the reflections' and particles' figures, the colour cast and noise level, and
+// the camera and video chain (image_degradation.h: defocus and motion blur, interlacing, JPEG),
+// applied after the distractors and before the sensor noise (JPEG last). The default look
+// (DefaultRenderLook) is the renderer described above, with the light colour of the dock's
+// `colour`.
+//
 // Frames: T_D_C maps camera coordinates (OpenCV: x right, y down, z optical axis) into the dock
 // frame D (origin on the deck, z down). Units: metres, pixels, 8-bit gray levels; radiances are
 // in full-scale units (1.0 = 255 gray levels at exposure 1).
@@ -64,6 +73,7 @@
 #include "auvdock/camera/camera_calibration.h"
 #include "auvdock/geometry/dock_model.h"
 #include "auvdock/geometry/pose3.h"
+#include "auvdock/sim/render_look.h"
 #include "auvdock/sim/water_model.h"
 
 namespace auvdock {
@@ -114,9 +124,13 @@ struct RenderResult {
 
 class UnderwaterRenderer {
  public:
-  // Precomputes the per-pixel unit rays in C (undistorted) and the vignetting, once.
+  // Precomputes the per-pixel unit rays in C (undistorted) and the vignetting, once. The first
+  // form uses the dock's default look (render_look.h).
   UnderwaterRenderer(const CameraCalibration& camera, const DockModel& dock,
                      const WaterModel& water, const RenderOptions& options);
+  UnderwaterRenderer(const CameraCalibration& camera, const DockModel& dock,
+                     const WaterModel& water, const RenderOptions& options,
+                     const RenderLook& look);
 
   // Geometric visibility without rasterising: the lights in front of the camera whose distorted
   // projection lies inside the image, whose emitting side faces the camera (emission cone of
@@ -131,6 +145,7 @@ class UnderwaterRenderer {
   const DockModel& dock() const { return dock_; }
   const WaterModel& water() const { return water_; }
   const RenderOptions& options() const { return options_; }
+  const RenderLook& look() const { return look_; }
 
  private:
   // Scene radiance (lamp-lit deck and seabed through the water), gray levels, CV_32FC3.
@@ -142,11 +157,14 @@ class UnderwaterRenderer {
   // Per-channel blob amplitude (gray levels) of a light seen at the given range and angle theta
   // off the optical axis.
   Eigen::Vector3d LightAmplitude(const DockLight& light, double range_m, double cos_theta) const;
+  // Adds one visible light with the look's halo, lobe and bloom to a CV_32FC3 image.
+  void DrawLight(const RenderedLight& rendered, const Pose3& T_C_D, cv::Mat* image) const;
 
   CameraCalibration camera_;
   DockModel dock_;
   WaterModel water_;
   RenderOptions options_;
+  RenderLook look_;
   // Per pixel, row-major: unit ray in C (x, y, z) and the gray-level gain 255 exposure vignette.
   std::vector<float> pixel_rays_;
   // Seabed albedo modulation, kTextureSize^2 texels over one period, wrapped.
