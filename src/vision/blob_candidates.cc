@@ -115,7 +115,8 @@ std::vector<BlobCandidate> FindBlobCandidates(const cv::Mat& luma,
   const float threshold = static_cast<float>(options.min_response);
   const cv::Mat kernel = cv::Mat::ones(3, 3, CV_8U);
   cv::Mat spatial_max;
-  for (int k = 0; k < n; ++k) {
+  const int last_scale = n > 1 && !options.keep_largest_scale ? n - 2 : n - 1;
+  for (int k = 0; k <= last_scale; ++k) {
     const cv::Mat& r = responses[k];
     cv::dilate(r, spatial_max, kernel);
     const int pixel = 1 << levels[k];
@@ -140,8 +141,8 @@ std::vector<BlobCandidate> FindBlobCandidates(const cv::Mat& luma,
   for (const BlobCandidate& c : found) {
     bool suppressed = false;
     for (const BlobCandidate& k : kept) {
-      const double radius =
-          std::max(options.nms_min_radius_px, options.nms_radius_sigmas * k.sigma_px);
+      const double radius = std::max(options.nms_min_radius_px,
+                                     options.nms_radius_sigmas * std::min(k.sigma_px, c.sigma_px));
       const double dx = c.x - k.x, dy = c.y - k.y;
       if (dx * dx + dy * dy < radius * radius) {
         suppressed = true;

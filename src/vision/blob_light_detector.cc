@@ -109,7 +109,7 @@ std::vector<LightDetection> BlobLightDetector::Detect(
     d.uv = core->uv;
     d.radius_px = std::max(core->radius_px, candidate.sigma_px);
     d.peak = core->peak;
-    const double strength = Clamp01(candidate.response / (2.0 * options_.candidates.min_response));
+    const double strength = Clamp01(candidate.response / options_.score_response);
     const double colour = has_colour && options_.checks.colour != LightColour::kWhite
                               ? Clamp01(evidence.halo_excess / (2.0 * checks.min_halo_excess))
                               : 1.0;

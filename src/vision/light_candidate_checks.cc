@@ -57,12 +57,53 @@ LightCandidateEvidence MeasureCandidateEvidence(const cv::Mat& bgr, const cv::Ma
     if (ring == kHaloRings - 1) {
       double brightest = -1.0;
       for (int k = 0; k < kSectors; ++k) {
-        if (sector_count[k] > 0) brightest = std::max(brightest, sector_luma[k] / sector_count[k]);
+        if (sector_count[k] == 0) continue;
+        brightest = std::max(brightest, sector_luma[k] / sector_count[k]);
       }
       evidence.peak_drop = brightest < 0.0 ? 0.0 : core.peak - brightest;
     }
   }
   if (!std::isfinite(evidence.halo_excess)) evidence.halo_excess = 0.0;
+
+  // Profile: the top (within sigma / 2, on a small grid) against the ring at sigma.
+  double top_sum = 0.0, mid_sum = 0.0;
+  int top_count = 0, mid_count = 0;
+  const double half = 0.5 * sigma_px;
+  const int reach = static_cast<int>(std::ceil(half));
+  const int cu = static_cast<int>(std::lround(core.uv.x()));
+  const int cv = static_cast<int>(std::lround(core.uv.y()));
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      const int px = cu + dx, py = cv + dy;
+      if (dx * dx + dy * dy > half * half + 0.5 || px < 0 || py < 0 || px >= luma.cols ||
+          py >= luma.rows) {
+        continue;
+      }
+      top_sum += luma.at<float>(py, px);
+      ++top_count;
+      if (colour_image) {
+        const cv::Vec3b& p = bgr.at<cv::Vec3b>(py, px);
+        const double brightest = std::max({p[0], p[1], p[2]});
+        evidence.saturated = evidence.saturated || brightest >= options.saturation_level;
+      } else {
+        evidence.saturated =
+            evidence.saturated || luma.at<float>(py, px) >= options.saturation_level;
+      }
+    }
+  }
+  for (int s = 0; s < kRingSamples; ++s) {
+    const double angle = 2.0 * kPi * s / kRingSamples;
+    const int px = static_cast<int>(std::lround(core.uv.x() + sigma_px * std::cos(angle)));
+    const int py = static_cast<int>(std::lround(core.uv.y() + sigma_px * std::sin(angle)));
+    if (px < 0 || py < 0 || px >= luma.cols || py >= luma.rows) continue;
+    mid_sum += luma.at<float>(py, px);
+    ++mid_count;
+  }
+  if (top_count > 0 && mid_count > 0) {
+    const double top = top_sum / top_count - core.floor;
+    const double mid = mid_sum / mid_count - core.floor;
+    evidence.flatness = top > 0.0 ? mid / top : 1.0;
+  }
   return evidence;
 }
 
@@ -87,7 +128,16 @@ std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore&
     return "extended";
   }
   if (core.touches_border) return "cut by the border";
-  if (evidence.peak_drop < options.min_peak_drop) return "not a peak";
+  if (core.elongation > options.max_core_elongation && core.area_px >= 12) return "elongated";
+  if (evidence.peak_drop < options.min_peak_drop ||
+      (!evidence.saturated &&
+       evidence.peak_drop < options.min_peak_drop_fraction * (core.peak - core.floor))) {
+    return "not a peak";
+  }
+  if (!evidence.saturated && candidate.sigma_px >= options.min_flat_sigma_px &&
+      evidence.flatness > options.max_flatness) {
+    return "flat top (a lit surface)";
+  }
   if (has_colour && options.colour != LightColour::kWhite &&
       evidence.halo_excess < options.min_halo_excess) {
     return "wrong colour (halo excess " + std::to_string(std::lround(evidence.halo_excess)) +

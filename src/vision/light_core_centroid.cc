@@ -116,6 +116,10 @@ std::optional<LightCore> MeasureLightCore(const cv::Mat& luma, int x, int y, dou
   core.floor = floor;
   core.area_px = static_cast<int>(members.size());
   core.radius_px = std::sqrt(core.area_px / 3.14159265358979323846);
+  // Unweighted second moment of the member pixels: the core's outline, whatever its weights.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> outline(
+      noise_term / static_cast<double>(members.size()) + Eigen::Matrix2d::Identity() / 12.0);
+  core.elongation = std::sqrt(outline.eigenvalues()(1) / outline.eigenvalues()(0));
   return core;
 }
 

@@ -276,6 +276,77 @@ TEST(BlobCandidates, ScaleOfAGaussianBlobIsItsSize) {
   }
 }
 
+// A grey scene with one unsaturated blue-green light (a Gaussian) and beside it a lit surface:
+// a flat-topped disc of the same tint (a white funnel in coloured water), or a long bar.
+cv::Mat LightBesideASurface(bool bar) {
+  cv::Mat image(200, 300, CV_32FC3, cv::Scalar(40, 45, 20));
+  const cv::Scalar tint(150, 160, 40);
+  if (bar) {
+    cv::rectangle(image, cv::Rect(170, 95, 60, 10), tint, cv::FILLED);
+  } else {
+    cv::circle(image, cv::Point(200, 100), 12, tint, cv::FILLED);
+  }
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 1.0);
+  for (int v = 0; v < image.rows; ++v) {
+    for (int u = 0; u < image.cols; ++u) {
+      const double d2 = (u - 70.3) * (u - 70.3) + (v - 100.6) * (v - 100.6);
+      const float w = static_cast<float>(150.0 * std::exp(-d2 / (2.0 * 3.5 * 3.5)));
+      image.at<cv::Vec3f>(v, u) += cv::Vec3f(0.9f * w, w, 0.2f * w);
+    }
+  }
+  cv::Mat out;
+  image.convertTo(out, CV_8UC3);
+  return out;
+}
+
+TEST(BlobLightDetector, LitSurfacesOfTheLightsTintAreNotLights) {
+  BlobLightDetectorOptions options;
+  options.checks.colour = LightColour::kBlueGreen;
+  const BlobLightDetector detector(options);
+  for (const bool bar : {false, true}) {
+    std::vector<RejectedLightCandidate> rejected;
+    const auto found = detector.Detect(LightBesideASurface(bar), &rejected);
+    ASSERT_EQ(found.size(), 1u) << (bar ? "bar" : "disc");
+    EXPECT_LT((found[0].uv - Eigen::Vector2d(70.3, 100.6)).norm(), 0.2);
+    bool said_why = false;
+    for (const auto& r : rejected) {
+      said_why = said_why || r.reason == "flat top (a lit surface)" || r.reason == "elongated" ||
+                 r.reason == "not a peak" || r.reason == "extended";
+    }
+    std::string reasons;
+    for (const auto& r : rejected) reasons += r.reason + "; ";
+
+    EXPECT_TRUE(said_why) << reasons;
+  }
+}
+
+TEST(BlobCandidates, ALargeStructureDoesNotHideASmallLightBesideIt) {
+  cv::Mat image(200, 200, CV_32F, cv::Scalar(20));
+  cv::circle(image, cv::Point(100, 100), 40, cv::Scalar(200), cv::FILLED);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 1.5);
+  for (int y = 0; y < 200; ++y) {
+    for (int x = 0; x < 200; ++x) {
+      const double d2 = (x - 100.0) * (x - 100.0) + (y - 152.0) * (y - 152.0);
+      image.at<float>(y, x) += 120.0f * static_cast<float>(std::exp(-0.5 * d2 / 4.0));
+    }
+  }
+  BlobCandidateOptions o;
+  o.max_sigma_px = 40.0;
+  o.num_scales = 10;
+  const auto found = FindBlobCandidates(image, o);
+  bool light = false;
+  for (const BlobCandidate& c : found) {
+    light = light || (std::abs(c.x - 100) <= 1 && std::abs(c.y - 152) <= 1 && c.sigma_px < 4.0);
+    EXPECT_LT(c.sigma_px, 39.0);  // never a maximum at the largest scale
+  }
+  EXPECT_TRUE(light);
+  o.keep_largest_scale = true;
+  o.max_sigma_px = 20.0;  // the disc's scale (~28 px) is beyond the range: its maximum is at 20
+  bool at_largest = false;
+  for (const BlobCandidate& c : FindBlobCandidates(image, o)) at_largest |= c.sigma_px > 19.9;
+  EXPECT_TRUE(at_largest);
+}
+
 TEST(BlobLightDetector, BadInputThrows) {
   EXPECT_THROW(BlobLightDetector().Detect(cv::Mat()), std::invalid_argument);
   EXPECT_THROW(BlobLightDetector().Detect(cv::Mat(10, 10, CV_32FC3)), std::invalid_argument);

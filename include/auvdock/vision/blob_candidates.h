@@ -6,9 +6,12 @@
 //   R_k(x) = -sigma_k^2 (Laplacian of (G_sigma_k * I))(x),
 // which for a Gaussian blob of amplitude A and size s peaks at sigma = s with R = A / 2, for
 // any s: the response compares blobs of every size on one scale (gray levels). A candidate is a
-// point where R_k is at least min_response and not below any of its 26 neighbours in (x, y, k).
-// Candidates closer than nms_radius_sigmas x sigma (at least nms_min_radius_px) to a stronger
-// one are dropped (one candidate per light: a light's halo makes weaker maxima around it).
+// point where R_k is at least min_response and not below any of its 26 neighbours in (x, y, k)
+// (at the largest scale, only with keep_largest_scale).
+// Candidates closer than nms_radius_sigmas x the smaller of the two sigmas (at least
+// nms_min_radius_px) to a stronger one are dropped (one candidate per light: a light's halo
+// makes weaker maxima around it); the smaller sigma, so that a large bright structure (a white
+// funnel at a coarse scale) does not hide the small lights around it.
 //
 // Large scales are computed on a Gaussian pyramid (cv::pyrDown: each level blurs by ~1.1 px of
 // its own resolution): the residual blur sqrt(sigma^2 - sigma_pyr^2) is applied at the coarsest
@@ -35,6 +38,10 @@ struct BlobCandidateOptions {
   double nms_radius_sigmas = 1.5;
   double nms_min_radius_px = 5.0;
   int max_candidates = 200;          // strongest first
+  // A maximum at the largest scale is not an extremum over scale (the response may still grow
+  // beyond it): a structure larger than any light the scales cover. Off: such maxima are dropped,
+  // and max_sigma_px only bounds the scale of the second-largest.
+  bool keep_largest_scale = false;
 };
 
 struct BlobCandidate {

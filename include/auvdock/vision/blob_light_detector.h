@@ -18,7 +18,7 @@
 // and its covariance widened by (border_sigma_fraction sigma)^2 per axis: the cut biases the
 // centroid by a fraction of the light's size.
 //
-// Score in [0, 1]: the geometric mean of response / (2 candidates.min_response) and halo_excess /
+// Score in [0, 1]: the geometric mean of response / score_response and halo_excess /
 // (2 min_halo_excess) (1 for white lights), each clamped to [0, 1].
 //
 // Units: pixels (0, 0 is the centre of the top-left pixel), gray levels. Detect() is const and
@@ -41,9 +41,13 @@ namespace auvdock {
 struct BlobLightDetectorOptions {
   bool deinterlace = false;  // keep the even field, rebuild odd rows (combing)
   // Scale-normalised LoG response of at least 30 gray levels: a light of ~60 levels of contrast
-  // at its own scale.
-  BlobCandidateOptions candidates{/*min_sigma_px=*/1.5, /*max_sigma_px=*/13.5, /*num_scales=*/7,
+  // at its own scale (lower thresholds let the pool footage's clutter through: at 10, precision
+  // 0.12 on the pool clip). Scales 1.44 apart from 1.5 px (the optics' blur) to 40 px; maxima at
+  // the largest are dropped (blob_candidates.h), so lights up to sigma ~28 px (a saturated
+  // plateau of ~40 px radius) are found.
+  BlobCandidateOptions candidates{/*min_sigma_px=*/1.5, /*max_sigma_px=*/40.0, /*num_scales=*/10,
                                   /*min_response=*/30.0};
+  double score_response = 60.0;  // a response that scores full strength
   LightCoreOptions core;
   LightCandidateCheckOptions checks;
   double min_separation_px = 3.0;

@@ -10,7 +10,15 @@
 //   peak_drop    = core peak - the brightest sector's mean luma on the ring, gray levels (a light
 //                  is brighter than its halo in every direction; an edge of a bright structure
 //                  is not: one sector is as bright as the centre);
-//   at_border    = the ring leaves the image (the halo, and the centroid with it, is cut).
+//   at_border    = the ring leaves the image (the halo, and the centroid with it, is cut);
+//   flatness     = (I_mid - floor) / (I_in - floor), I_in the mean luma within sigma / 2 of c,
+//                  I_mid on the ring at sigma: ~0.4-0.7 for a light's bell-shaped profile at its
+//                  own scale (a Gaussian's is exp(-1/2) over its top), ~1 for a flat top: a lit
+//                  surface (a white funnel, a deck, a wall seen through a gap) whose blob scale
+//                  the disc sets. A saturated core is flat too, so the test is for unsaturated
+//                  cores only (saturated: a colour channel reaches saturation_level within
+//                  sigma / 2), and for sigma >= min_flat_sigma_px (smaller blobs are shaped by
+//                  the optics, whatever emits them).
 // Units: pixels and gray levels.
 #pragma once
 
@@ -34,14 +42,28 @@ struct LightCandidateCheckOptions {
   // ~120-190, white and grey clutter stays below ~35; a footage's own value is learned from its
   // identified lights (halo_colour_learner.h).
   double min_halo_excess = 40.0;
-  double min_peak_drop = 1.0;       // gray levels
+  // The core must stand above the brightest sector of the outer ring by min_peak_drop gray levels
+  // and, when it is not saturated, by min_peak_drop_fraction of its contrast (peak - floor): an
+  // unsaturated light's ring at 2 sigma holds ~15 % of its peak, a corner or edge of a lit surface
+  // about all of it. (A saturated light's clipped contrast says little: a LED beside a white
+  // funnel may have the funnel in one sector of its ring.)
+  double min_peak_drop = 1.0;
+  double min_peak_drop_fraction = 0.1;
   double max_core_radius_sigmas = 2.0;  // a core wider than this is a bright surface
+  double max_flatness = 0.85;
+  // A light's core is round: an emitting disc seen through round optics (motion blur of a few
+  // pixels, combing or a lobe stretch it a little); a lit patch of a structure need not be.
+  double max_core_elongation = 3.5;
+  double min_flat_sigma_px = 3.0;
+  double saturation_level = 250.0;  // gray levels, any channel
 };
 
 struct LightCandidateEvidence {
   double halo_excess = 0.0;
   double peak_drop = 0.0;
   bool at_border = false;
+  double flatness = 0.0;
+  bool saturated = false;
 };
 
 // bgr: CV_8UC3 (or CV_8UC1: no colour, halo_excess = 0); luma: CV_32FC1 of the same size.
@@ -56,7 +78,7 @@ double MedianColourExcess(const cv::Mat& bgr, LightColour colour);
 
 // Empty when the candidate passes; otherwise a short reason ("extended", "cut by the
 // border" (the core itself reaches the image's edge: its centre is biased by an unknown amount
-// and the light may be mostly outside), "not a peak", "wrong colour").
+// and the light may be mostly outside), "not a peak", "flat top", "wrong colour").
 std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore& core,
                                 const LightCandidateEvidence& evidence, bool has_colour,
                                 const LightCandidateCheckOptions& options);

@@ -24,6 +24,7 @@
 #include <optional>
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <opencv2/core.hpp>
 
 namespace auvdock {
@@ -45,6 +46,9 @@ struct LightCore {
   double floor = 0.0;      // gray levels
   int area_px = 0;         // pixels in the core
   double radius_px = 0.0;  // sqrt(area / pi)
+  // sqrt of the ratio of the eigenvalues of the core pixels' second moment (1: round; a 2:1
+  // ellipse 2).
+  double elongation = 1.0;
   bool touches_window = false;  // the core reaches the window's edge (not a compact core)
   bool touches_border = false;  // the core reaches the image's edge (cut: its centre is biased)
 };
