@@ -79,16 +79,6 @@ double MedianStateInterval(const std::vector<std::unique_ptr<BatchState>>& state
 
 }  // namespace
 
-double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
-                                double frame_interval_s) {
-  const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
-  if (!positive(floor_px) || !positive(correlation_time_s) || !positive(frame_interval_s)) {
-    return 0.0;
-  }
-  const double one_minus_rho = -std::expm1(-frame_interval_s / correlation_time_s);
-  const double n_c = (2.0 - one_minus_rho) / one_minus_rho;  // (1 + rho) / (1 - rho)
-  return n_c * floor_px * floor_px;
-}
 
 BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
                         const std::vector<VisionFrame>& frames,

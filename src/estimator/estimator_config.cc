@@ -41,6 +41,9 @@ RunConfig LoadRunConfig(const std::string& path) {
       est.GetNonNegative("smoother_vision_floor_px", e.smoother_vision_floor_px);
   e.smoother_vision_correlation_time_s = est.GetNonNegative("smoother_vision_correlation_time_s",
                                                             e.smoother_vision_correlation_time_s);
+  e.window_vision_floor_px = est.GetNonNegative("window_vision_floor_px", e.window_vision_floor_px);
+  e.window_vision_correlation_time_s = est.GetNonNegative("window_vision_correlation_time_s",
+                                                          e.window_vision_correlation_time_s);
 
   GoNoGoOptions& g = config.go_no_go;
   const ConfigNode go = root.ChildOrEmpty("go_no_go");

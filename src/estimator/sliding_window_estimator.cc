@@ -244,6 +244,8 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
                          " ns out of order or repeated: skipped");
     return std::nullopt;
   }
+  const double frame_interval_s =
+      last_frame_t_ns_ != INT64_MIN ? static_cast<double>(frame.t_ns - last_frame_t_ns_) * 1e-9 : 0.0;
   last_frame_t_ns_ = frame.t_ns;
 
   if (window_.empty()) {
@@ -257,6 +259,9 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   VisionFactorOptions vision = options_.vision;
   for (const auto& [id, scale] : mono_noise_) vision.mono_variance_factor[id] = scale.factor();
   for (const auto& [id, scale] : stereo_noise_) vision.stereo_variance_factor[id] = scale.factor();
+  vision.correlated_pixel_variance =
+      CorrelatedVisionVariance(options_.window_vision_floor_px,
+                               options_.window_vision_correlation_time_s, frame_interval_s);
   state->vision = AddVisionFactors(problem_.get(), frame, rig_, vision, state->pose,
                                    &stats_.skipped_observations);
 

@@ -61,13 +61,6 @@ struct BatchResult {
   EstimatorStats stats;  // skipped / gated / used counts
 };
 
-// The variance (px^2) added to every pixel coordinate of the smoother's vision residuals for a
-// slow error of 1-sigma floor_px and correlation time correlation_time_s, at the frame interval
-// frame_interval_s: N_c floor_px^2, N_c = (1 + rho) / (1 - rho), rho = exp(-dt / tau). 0 when
-// any argument is 0 (or not finite and positive).
-double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
-                                double frame_interval_s);
-
 // frames: every vision frame of the log, in time order (frames without a warm-start state are
 // ignored); imu: all samples in time order. Throws std::invalid_argument without an IMU
 // calibration.

@@ -15,6 +15,8 @@
 //     stage_weighting: information     # or paper_light_count
 //     smoother_vision_floor_px: 0.075  # batch smoother: slow part of the pixel errors; 0 = white
 //     smoother_vision_correlation_time_s: 2.0
+//     window_vision_floor_px: 0.07     # sliding window: the same model; 0 = white errors only
+//     window_vision_correlation_time_s: 1.0
 //   go_no_go:
 //     allowed_lateral_error_m: 0.10
 //     max_yaw_3sigma_rad: 0.05

@@ -71,6 +71,13 @@ struct VisionRig {
   const DockModel* dock = nullptr;
 };
 
+// The variance (px^2) added to every pixel coordinate of the vision residuals (the batch smoother's and, when configured, the sliding window's) for a
+// slow error of 1-sigma floor_px and correlation time correlation_time_s, at the frame interval
+// frame_interval_s: N_c floor_px^2, N_c = (1 + rho) / (1 - rho), rho = exp(-dt / tau). 0 when
+// any argument is 0 (or not finite and positive).
+double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
+                                double frame_interval_s);
+
 // Adds the frame's residuals on `pose` (a block already in the problem). Observations with an
 // unknown light id or non-finite values, and mono observations of a light behind the camera at
 // the pose block's current value, are skipped and counted in *n_skipped.
