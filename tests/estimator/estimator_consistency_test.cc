@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -132,6 +133,20 @@ TEST(EstimatorConsistencyTest, SmootherAneesOverTwentyRunsIsInTheChiSquareBand) 
   tally.Check(kRuns, 0.80, "batch smoother");
 }
 
+// The pose NEES of an output at frame k against the run's truth, when the frame counts: a
+// covariance, after the first 2 s, a camera system seeing at least 3 lights.
+std::optional<double> CountedNees(const test::SyntheticRun& run, size_t k,
+                                  const EstimatorOutput& out) {
+  if (!out.covariance_ok || k < 20) return std::nullopt;
+  if (run.frames[k].mono.size() < 3 && run.frames[k].stereo.size() < 3) return std::nullopt;
+  const Pose3& truth = run.truth[k].T_D_B;
+  Eigen::Matrix<double, 6, 1> e;
+  e.head<3>() = out.T_D_B.p - truth.p;
+  const Eigen::AngleAxisd aa(out.T_D_B.q * truth.q.conjugate());
+  e.tail<3>() = aa.angle() * aa.axis();
+  return e.dot(out.covariance.ldlt().solve(e));
+}
+
 // Mean pose NEES of the sliding window over seeds [1, num_seeds] (frames where a camera system
 // sees at least 3 lights, after the first 2 s), with the given pixel noise and options.
 double WindowMeanNees(const test::SyntheticPixelNoise& noise, const EstimatorOptions& options,
@@ -143,15 +158,10 @@ double WindowMeanNees(const test::SyntheticPixelNoise& noise, const EstimatorOpt
     const test::SyntheticRun run = test::MakeSyntheticRun(scenario, seed, noise);
     SlidingWindowEstimator estimator(run.calibration, run.dock, options);
     for (const auto& [k, out] : RunWindow(run, &estimator)) {
-      if (!out.covariance_ok || k < 20) continue;
-      if (run.frames[k].mono.size() < 3 && run.frames[k].stereo.size() < 3) continue;
-      const Pose3& truth = run.truth[k].T_D_B;
-      Eigen::Matrix<double, 6, 1> e;
-      e.head<3>() = out.T_D_B.p - truth.p;
-      const Eigen::AngleAxisd aa(out.T_D_B.q * truth.q.conjugate());
-      e.tail<3>() = aa.angle() * aa.axis();
-      sum += e.dot(out.covariance.ldlt().solve(e));
-      ++count;
+      if (const auto nees = CountedNees(run, k, out)) {
+        sum += *nees;
+        ++count;
+      }
     }
   }
   return sum / std::max(1, count);
@@ -204,16 +214,10 @@ double SmootherMeanNees(const test::SyntheticPixelNoise& noise, const EstimatorO
     double run_sum = 0.0;
     int run_count = 0;
     for (const EstimatorOutput& out : batch.outputs) {
-      const size_t k = frame_at.at(out.t_ns);
-      if (!out.covariance_ok || k < 20) continue;
-      if (run.frames[k].mono.size() < 3 && run.frames[k].stereo.size() < 3) continue;
-      const Pose3& truth = run.truth[k].T_D_B;
-      Eigen::Matrix<double, 6, 1> e;
-      e.head<3>() = out.T_D_B.p - truth.p;
-      const Eigen::AngleAxisd aa(out.T_D_B.q * truth.q.conjugate());
-      e.tail<3>() = aa.angle() * aa.axis();
-      run_sum += e.dot(out.covariance.ldlt().solve(e));
-      ++run_count;
+      if (const auto nees = CountedNees(run, frame_at.at(out.t_ns), out)) {
+        run_sum += *nees;
+        ++run_count;
+      }
     }
     EXPECT_GT(run_count, 250) << seed;
     std::printf("seed %2llu: smoother mean NEES %.2f over %d frames\n",
@@ -223,7 +227,6 @@ double SmootherMeanNees(const test::SyntheticPixelNoise& noise, const EstimatorO
   }
   return sum / std::max(1, count);
 }
-
 
 // Pixel errors with a slow per-camera offset (0.1 px, correlation time 2 s) on top of 0.3 px
 // white noise. Assuming white errors, the smoother fuses ~400 frames as independent and its
