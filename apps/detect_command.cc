@@ -12,8 +12,9 @@
 //   OUTDIR/frames.csv      frame,image,detections,identified,status,tracked,rms_px,sigma_px,
 //                          tx,ty,tz,qx,qy,qz,qw (T_C_D, empty without a pose),symmetry,reason
 //   OUTDIR/camera_poses.tum  T_D_C per frame with a pose, time = frame / rate_hz of the camera
-//   OUTDIR/summary.json    counts, the reasons' counts, time per frame, and with --labels the
-//                          evaluation against the labels (detection_evaluation.h)
+//   OUTDIR/summary.json    counts, the reasons' counts, the rejected candidates' counts by kind,
+//                          time per frame, and with --labels the evaluation against the labels
+//                          (detection_evaluation.h)
 //   OUTDIR/rejected.csv    (--overlay) frame,image,u,v,sigma,reason of every blob candidate
 //                          that failed a check
 //   OUTDIR/overlay/IMAGE.png (--overlay) detections (green: identified, with the id; yellow:
@@ -156,6 +157,7 @@ void RunDetect(const DetectOptions& options) {
   const CancellationToken cancel = InstallSignalCancellation();
   std::map<std::string, FrameDetections> evaluated;
   std::map<std::string, int> reasons;
+  std::map<std::string, int> rejected_reasons;  // every image's rejected candidates, by kind
   int n_frames = 0, n_pose = 0, n_tracked = 0, n_detections = 0, n_no_detection = 0;
   double detect_s = 0.0, pose_s = 0.0;
   bool interrupted = false;
@@ -183,7 +185,7 @@ void RunDetect(const DetectOptions& options) {
     const auto t0 = Clock::now();
     std::vector<RejectedLightCandidate> rejected;
     const std::vector<LightDetection> detections =
-        detector.Detect(image, options.overlay ? &rejected : nullptr, colour_learner.threshold());
+        detector.Detect(image, &rejected, colour_learner.threshold());
     const auto t1 = Clock::now();
     const MonoPoseResult pose = poser.Process(detections);
     const auto t2 = Clock::now();
@@ -226,7 +228,23 @@ void RunDetect(const DetectOptions& options) {
       row += ",,,,,,,,";
       ++reasons[ReasonClass(pose.reason)];
     }
+    // Why the detector found too few lights: its rejected candidates, by kind (a wrong colour
+    // setting shows here as "wrong colour" in every image).
+    std::map<std::string, int> rejected_here;
+    for (const RejectedLightCandidate& r : rejected) {
+      const std::string kind = r.reason.substr(0, r.reason.find(" ("));
+      ++rejected_here[kind];
+      ++rejected_reasons[kind];
+    }
     std::string reason = pose.reason;
+    if (!pose.T_C_D && !rejected_here.empty() &&
+        static_cast<int>(detections.size()) < poser_options.min_lights) {
+      const auto most = std::max_element(
+          rejected_here.begin(), rejected_here.end(),
+          [](const auto& a, const auto& b) { return a.second < b.second; });
+      reason += " (" + std::to_string(rejected.size()) + " candidates rejected; most often: " +
+                most->first + ")";
+    }
     std::replace(reason.begin(), reason.end(), ',', ';');
     std::string symmetry = pose.symmetry_note;
     std::replace(symmetry.begin(), symmetry.end(), ',', ';');
@@ -258,6 +276,7 @@ void RunDetect(const DetectOptions& options) {
   summary["detections"] = n_detections;
   summary["colour"] = LightColourName(colour);
   summary["no_pose_reasons"] = reasons;
+  summary["rejected_candidates"] = rejected_reasons;
   summary["halo_colour"] = {
       {"learned", colour_learner.learned()},
       {"threshold", colour_learner.threshold()},
@@ -268,6 +287,21 @@ void RunDetect(const DetectOptions& options) {
               options.out.c_str(), n_pose, n_tracked, n_detections);
   for (const auto& [reason, count] : reasons) {
     std::printf("  no pose: %d x %s\n", count, reason.c_str());
+  }
+  if (!rejected_reasons.empty()) {
+    std::vector<std::pair<int, std::string>> by_count;
+    for (const auto& [kind, count] : rejected_reasons) by_count.emplace_back(count, kind);
+    std::sort(by_count.rbegin(), by_count.rend());
+    std::string line;
+    for (const auto& [count, kind] : by_count) {
+      line += (line.empty() ? "" : ", ") + std::to_string(count) + " " + kind;
+    }
+    std::printf("  candidates rejected: %s\n", line.c_str());
+    if (n_pose == 0 && by_count.front().second == "wrong colour") {
+      std::printf("  no pose in any image and most candidates had the wrong colour: are the lights "
+                  "%s (--colour, dock.yaml colour)?\n",
+                  LightColourName(colour));
+    }
   }
   if (labels) {
     DetectionEvaluationOptions evaluation_options;

@@ -155,6 +155,28 @@ void ExpectOneLineExitTwo(const std::vector<std::string>& args, const std::strin
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
 }
 
+// Blue LEDs searched for as red: nothing is silently empty; every frame and the summary say the
+// candidates had the wrong colour, and the end of the run asks whether the colour is right.
+TEST(DetectCli, AWrongColourSaysSo) {
+  Footage footage;
+  std::filesystem::create_directories(footage.dir / "frames");
+  MakeFootage(&footage, 2);
+  const std::string out = footage.dir / "out";
+  std::vector<std::string> args = DetectArgs(footage, out);
+  args.push_back("--colour");
+  args.push_back("red");
+  const test::CommandResult r = test::RunAuvdock(args);
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("most candidates had the wrong colour: are the lights red"),
+            std::string::npos)
+      << r.out;
+  const std::string frames = test::ReadTextFile(out + "/frames.csv");
+  EXPECT_NE(frames.find("most often: wrong colour"), std::string::npos) << frames;
+  const nlohmann::json summary = nlohmann::json::parse(test::ReadTextFile(out + "/summary.json"));
+  EXPECT_EQ(summary["frames_with_pose"], 0);
+  EXPECT_GT(summary["rejected_candidates"]["wrong colour"].get<int>(), 8);
+}
+
 TEST(DetectCli, BadInputIsOneLineAndExitTwo) {
   Footage footage;
   std::filesystem::create_directories(footage.dir / "frames");
