@@ -2,6 +2,7 @@
 # Accuracy, covariance consistency (NEES) and go/no-go safety of `auvdock run` (and `smooth`
 # with --smooth) over several seeds of a scenario, on the full image pipeline:
 #   bash scripts/evaluate_seeds.sh [--scenario FILE] [--seeds "1 2 3"] [--out DIR] [--smooth]
+#                                  [--detector contrast|blob]
 # Needs a built tree (scripts/build.sh). Per seed it simulates, estimates and evaluates into
 # OUT/seed_N/, then prints one table: position RMSE and mean NEES by stage, GO count, unsafe GO
 # and the largest true lateral error at GO, and the means over the seeds.
@@ -11,12 +12,14 @@ scenario=data/scenarios/default.yaml
 seeds="1 2 3 4 5"
 out=out/seeds
 commands="run"
+detector=contrast
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
     --seeds) seeds="$2"; shift 2 ;;
     --out) out="$2"; shift 2 ;;
     --smooth) commands="run smooth"; shift ;;
+    --detector) detector="$2"; shift 2 ;;
     *) echo "evaluate_seeds.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -28,7 +31,8 @@ for seed in $seeds; do
   rm -rf "$dir"   # this script's own folder from an earlier call
   "$bin" simulate --scenario "$scenario" --seed "$seed" --out "$dir/dataset" --quiet
   for command in $commands; do
-    "$bin" "$command" --dataset "$dir/dataset" --out "$dir/$command" --quiet > /dev/null
+    "$bin" "$command" --dataset "$dir/dataset" --out "$dir/$command" --detector "$detector" \
+      --quiet > /dev/null
     "$bin" evaluate --dataset "$dir/dataset" --estimate "$dir/$command/trajectory.tum" \
       --covariance "$dir/$command/covariance.csv" --decisions "$dir/$command/decisions.csv" \
       --json > "$dir/$command/evaluation.json"
