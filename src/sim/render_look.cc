@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 #include "auvdock/sim/random_stream.h"
 
@@ -10,10 +9,6 @@ namespace auvdock {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-double Uniform(std::mt19937_64& rng, double lo, double hi) {
-  return lo + (hi - lo) * Uniform01(rng);
-}
 
 bool Coin(std::mt19937_64& rng, double p) { return Uniform01(rng) < p; }
 
@@ -142,18 +137,20 @@ const LightLobe* RenderLook::FindLobe(int light_id) const {
   return nullptr;
 }
 
-Eigen::Vector3d LightColourBgr(const std::string& colour_name) {
-  if (colour_name == "blue_green") return Eigen::Vector3d(0.85, 1.0, 0.2);
-  if (colour_name == "blue") return Eigen::Vector3d(1.0, 0.55, 0.15);
-  if (colour_name == "green") return Eigen::Vector3d(0.3, 1.0, 0.25);
-  if (colour_name == "red") return Eigen::Vector3d(0.15, 0.25, 1.0);
-  if (colour_name == "white") return Eigen::Vector3d(0.95, 1.0, 0.95);
-  throw std::invalid_argument("unknown light colour '" + colour_name + "'");
+Eigen::Vector3d LightColourBgr(LightColour colour) {
+  switch (colour) {
+    case LightColour::kBlueGreen: return Eigen::Vector3d(0.85, 1.0, 0.2);
+    case LightColour::kBlue: return Eigen::Vector3d(1.0, 0.55, 0.15);
+    case LightColour::kGreen: return Eigen::Vector3d(0.3, 1.0, 0.25);
+    case LightColour::kRed: return Eigen::Vector3d(0.15, 0.25, 1.0);
+    case LightColour::kWhite: break;
+  }
+  return Eigen::Vector3d(0.95, 1.0, 0.95);
 }
 
 RenderLook DefaultRenderLook(const DockModel& dock) {
   RenderLook look;
-  look.light_colour_bgr = LightColourBgr(dock.light_colour);
+  look.light_colour_bgr = LightColourBgr(ParseLightColour(dock.light_colour));
   return look;
 }
 

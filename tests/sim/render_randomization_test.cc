@@ -66,6 +66,15 @@ TEST(RenderLook, TheDefaultLookIsTheUnrandomisedRenderer) {
   EXPECT_TRUE(SameImage(plain.Render(T_D_C, a).image, with_look.Render(T_D_C, b).image));
 }
 
+TEST(RenderLook, TheLightColourFollowsTheDockIncludingItsAliases) {
+  DockModel dock = test::MakeTDock();
+  dock.light_colour = "cyan";  // an alias of blue_green that dock.yaml accepts
+  EXPECT_EQ(DefaultRenderLook(dock).light_colour_bgr, LightColourBgr(LightColour::kBlueGreen));
+  dock.light_colour = "blue";
+  const Eigen::Vector3d blue = DefaultRenderLook(dock).light_colour_bgr;
+  EXPECT_GT(blue[0], blue[2]);
+}
+
 TEST(RenderLook, LooksAreSeededAndDiffer) {
   const DockModel dock = test::MakeTDock();
   RenderRandomization on;

@@ -31,6 +31,10 @@ inline std::mt19937_64 MakeRandomStream(uint64_t seed, RandomStreamId id) {
 
 // Uniform in [0, 1) with 53 random bits.
 double Uniform01(std::mt19937_64& rng);
+// Uniform in [lo, hi).
+inline double Uniform(std::mt19937_64& rng, double lo, double hi) {
+  return lo + (hi - lo) * Uniform01(rng);
+}
 // Standard normal (Box-Muller).
 double StandardNormal(std::mt19937_64& rng);
 Eigen::Vector3d StandardNormal3(std::mt19937_64& rng);

@@ -55,6 +55,7 @@
 #include <Eigen/Core>
 
 #include "auvdock/geometry/dock_model.h"
+#include "auvdock/vision/light_colour.h"
 
 namespace auvdock {
 
@@ -135,8 +136,8 @@ struct RenderLook {
   const LightLobe* FindLobe(int light_id) const;
 };
 
-// The base colour (B, G, R, max 1) of a dock colour name (vision/light_colour.h names).
-Eigen::Vector3d LightColourBgr(const std::string& colour_name);
+// The base colour (B, G, R, max 1) of a light colour.
+Eigen::Vector3d LightColourBgr(LightColour colour);
 
 // The un-randomised look for a dock: its light colour, no halo, lobes, structures or video
 // effects.
