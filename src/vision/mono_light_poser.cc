@@ -13,9 +13,25 @@ MonoLightPoser::MonoLightPoser(const CameraCalibration& camera, const DockModel&
     : camera_(camera), dock_(dock), options_(options), rng_(options.seed) {}
 
 MonoPoseResult MonoLightPoser::Process(const std::vector<LightDetection>& detections) {
+  ++frames_since_pose_;
+  return Solve(detections);
+}
+
+MonoPoseResult MonoLightPoser::Retry(const std::vector<LightDetection>& detections) {
+  return Solve(detections);
+}
+
+std::optional<Pose3> MonoLightPoser::TrackedPose() const {
+  // Called between frames: the next Process counts one more frame since the pose.
+  if (!options_.use_tracking || !last_T_C_D_ || frames_since_pose_ + 1 > options_.max_gap_frames) {
+    return std::nullopt;
+  }
+  return last_T_C_D_;
+}
+
+MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detections) {
   MonoPoseResult result;
   result.light_ids.assign(detections.size(), -1);
-  ++frames_since_pose_;
 
   // The noise the detections claim (their own covariances), never below the camera's.
   double trace_sum = 0.0;
@@ -30,25 +46,35 @@ MonoPoseResult MonoLightPoser::Process(const std::vector<LightDetection>& detect
   if (measured > 0) sigma = std::max(sigma, std::sqrt(trace_sum / measured / 2.0));
   result.pixel_sigma_px = sigma;
 
-  if (static_cast<int>(detections.size()) < options_.min_lights) {
+  const bool can_track =
+      options_.use_tracking && last_T_C_D_ && frames_since_pose_ <= options_.max_gap_frames;
+  const int needed = can_track ? std::min(options_.min_tracked_lights, options_.min_lights)
+                               : options_.min_lights;
+  if (static_cast<int>(detections.size()) < needed) {
     result.reason = "only " + std::to_string(detections.size()) + " detections (need " +
-                    std::to_string(options_.min_lights) + ")";
+                    std::to_string(needed) + ")";
     return result;
   }
 
   MatchResult match;
   std::optional<Pose3> start;
-  if (options_.use_tracking && last_T_C_D_ && frames_since_pose_ <= options_.max_gap_frames) {
+  if (can_track) {
     TrackingMatcherOptions tracking = options_.tracking;
     tracking.gate_px = options_.tracking_gate_px;
     tracking.pixel_noise_px = sigma;
     tracking.final_gate_px = std::max(tracking.final_gate_px, 6.0 * sigma);
-    tracking.min_matches = options_.min_lights;
+    tracking.min_matches = needed;
     match = MatchByPrediction(detections, dock_, camera_.intrinsics, *last_T_C_D_, tracking);
     if (match.status == MatchStatus::kOk) {
       result.tracked = true;
       start = last_T_C_D_;
     }
+  }
+  if (!result.tracked && static_cast<int>(detections.size()) < options_.min_lights) {
+    result.reason = "only " + std::to_string(detections.size()) + " detections (need " +
+                    std::to_string(options_.min_lights) + " without tracking: " + match.reason +
+                    ")";
+    return result;
   }
   if (!result.tracked) {
     RansacMatcherOptions ransac = options_.ransac;

@@ -3,7 +3,8 @@
 //
 // Per frame: with a pose from the previous frame (at most max_gap_frames old), the detections
 // are labelled by prediction (MatchByPrediction, tracking_gate_px: the motion between frames);
-// otherwise, or if that fails, from scratch (MatchRansac). The labelled lights then give the pose
+// otherwise, or if that fails, from scratch (MatchRansac). Tracking needs min_tracked_lights, from
+// scratch min_lights. The labelled lights then give the pose
 // by PnP (SolvePnp, started at the matcher's pose) with the pixel noise
 //   sigma = max(camera pixel_noise_px, sqrt(mean over the used detections of trace(C_i) / 2)),
 // C_i a detection's own centroid covariance (zero: not measured), so that PnP's covariance and
@@ -41,6 +42,11 @@ struct MonoLightPoserOptions {
   double tracking_gate_px = 40.0;
   int max_gap_frames = 3;
   int min_lights = 4;
+  // While tracking, fewer lights may do (a close dock leaving the image: PnP refines the tracked
+  // pose, which tells P3P's solutions apart), but 3 lights fit any pose exactly: nothing checks
+  // the labels. On the pool clip, 3 let the labelling drift to a wrong one (precision 0.977 ->
+  // 0.940), so by default tracking needs min_lights too.
+  int min_tracked_lights = 4;
   bool use_tracking = true;
   // Gravity's direction in the camera frame when the camera's attitude is roughly known (a
   // camera held upright: (0, 1, 0)), to choose among a symmetric dock's poses (SymmetryHint).
@@ -68,12 +74,22 @@ class MonoLightPoser {
   MonoLightPoser(const CameraCalibration& camera, const DockModel& dock,
                  const MonoLightPoserOptions& options = {});
 
+  // The next frame's detections.
   MonoPoseResult Process(const std::vector<LightDetection>& detections);
+  // The same frame again with other detections (a second detection pass), when Process gave no
+  // pose: the tracking state is that of the frame, not one frame older.
+  MonoPoseResult Retry(const std::vector<LightDetection>& detections);
+
+  // The last pose, while tracking may use it for the next frame (use_tracking, at most
+  // max_gap_frames old); otherwise nothing.
+  std::optional<Pose3> TrackedPose() const;
 
  private:
   CameraCalibration camera_;
   DockModel dock_;
   MonoLightPoserOptions options_;
+  MonoPoseResult Solve(const std::vector<LightDetection>& detections);
+
   std::mt19937_64 rng_;
   std::optional<Pose3> last_T_C_D_;
   int frames_since_pose_ = 0;
