@@ -55,12 +55,16 @@ LightCandidateEvidence MeasureCandidateEvidence(const cv::Mat& bgr, const cv::Ma
           std::max(evidence.halo_excess, excess_sum / excess_count - background_excess);
     }
     if (ring == kHaloRings - 1) {
-      double brightest = -1.0;
+      std::vector<double> means;
       for (int k = 0; k < kSectors; ++k) {
-        if (sector_count[k] == 0) continue;
-        brightest = std::max(brightest, sector_luma[k] / sector_count[k]);
+        if (sector_count[k] > 0) means.push_back(sector_luma[k] / sector_count[k]);
       }
-      evidence.peak_drop = brightest < 0.0 ? 0.0 : core.peak - brightest;
+      std::sort(means.rbegin(), means.rend());
+      evidence.peak_drop = means.empty() ? 0.0 : core.peak - means.front();
+      const size_t open = std::min(means.size(), static_cast<size_t>(options.open_sectors));
+      evidence.open_drop = means.size() < static_cast<size_t>(kSectors) - open + 1
+                               ? evidence.peak_drop
+                               : core.peak - means[kSectors - open];
     }
   }
   if (!std::isfinite(evidence.halo_excess)) evidence.halo_excess = 0.0;
@@ -132,6 +136,10 @@ std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore&
   if (evidence.peak_drop < options.min_peak_drop ||
       (!evidence.saturated &&
        evidence.peak_drop < options.min_peak_drop_fraction * (core.peak - core.floor))) {
+    return "not a peak";
+  }
+  if (evidence.saturated &&
+      evidence.open_drop < options.min_open_drop_fraction * (core.peak - core.floor)) {
     return "not a peak";
   }
   if (!evidence.saturated && candidate.sigma_px >= options.min_flat_sigma_px &&

@@ -320,6 +320,48 @@ TEST(BlobLightDetector, LitSurfacesOfTheLightsTintAreNotLights) {
   }
 }
 
+// A funnel that the water's cast saturates in two channels (cyan: B and G clipped, R not), with
+// a slightly brighter rim, noise and JPEG, and a saturated LED just beside it. Small blobs on the
+// funnel's edge have the funnel in half their ring: the open-sector test rejects them, and keeps
+// the LED, which has the funnel in a few sectors of its ring. (Coarse-scale candidates on the rim,
+// whose ring reaches past the convex edge, still pass: the renders' remaining funnel clutter.)
+TEST(BlobLightDetector, SmallBlobsOnTheEdgeOfASaturatedSurfaceAreNotLights) {
+  cv::Mat image(240, 320, CV_32FC3, cv::Scalar(60, 70, 30));
+  cv::ellipse(image, cv::Point(120, 120), cv::Size(70, 80), 0, 0, 360, cv::Scalar(300, 300, 110),
+              3);  // the rim
+  cv::ellipse(image, cv::Point(120, 120), cv::Size(69, 79), 0, 0, 360, cv::Scalar(280, 280, 85),
+              cv::FILLED);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 0.8);
+  const test::Led led{Eigen::Vector2d(212.3, 121.4), 2.5, 6.0};
+  test::AddLed(led, &image);
+  cv::Mat noise(image.size(), CV_32FC3);
+  cv::RNG(4).fill(noise, cv::RNG::NORMAL, 0.0, 6.0);
+  image += noise;
+  cv::Mat bgr;
+  image.convertTo(bgr, CV_8UC3);
+  std::vector<uchar> buffer;
+  cv::imencode(".jpg", bgr, buffer, {cv::IMWRITE_JPEG_QUALITY, 60});
+  bgr = cv::imdecode(buffer, cv::IMREAD_COLOR);
+  BlobLightDetectorOptions options;
+  options.checks.colour = LightColour::kBlueGreen;
+  auto small_on_the_edge = [&](const std::vector<LightDetection>& found) {
+    int n = 0;
+    for (const LightDetection& d : found) n += d.radius_px < 8.0 && (d.uv - led.uv).norm() > 3.0;
+    return n;
+  };
+  auto has_led = [&](const std::vector<LightDetection>& found) {
+    return std::any_of(found.begin(), found.end(),
+                       [&](const LightDetection& d) { return (d.uv - led.uv).norm() < 0.5; });
+  };
+  const auto with_test = BlobLightDetector(options).Detect(bgr);
+  EXPECT_TRUE(has_led(with_test));
+  EXPECT_EQ(small_on_the_edge(with_test), 0);
+  options.checks.min_open_drop_fraction = 0.0;
+  const auto without_test = BlobLightDetector(options).Detect(bgr);
+  EXPECT_TRUE(has_led(without_test));
+  EXPECT_GT(small_on_the_edge(without_test), 0);
+}
+
 TEST(BlobCandidates, ALargeStructureDoesNotHideASmallLightBesideIt) {
   cv::Mat image(200, 200, CV_32F, cv::Scalar(20));
   cv::circle(image, cv::Point(100, 100), 40, cv::Scalar(200), cv::FILLED);

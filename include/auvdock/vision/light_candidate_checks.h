@@ -10,6 +10,9 @@
 //   peak_drop    = core peak - the brightest sector's mean luma on the ring, gray levels (a light
 //                  is brighter than its halo in every direction; an edge of a bright structure
 //                  is not: one sector is as bright as the centre);
+//   open_drop    = core peak - the open_sectors-th dimmest sector's mean: a saturated light
+//                  beside a bright surface has the surface in a few sectors, an edge of a
+//                  saturated surface in half of them;
 //   at_border    = the ring leaves the image (the halo, and the centroid with it, is cut);
 //   flatness     = (I_mid - floor) / (I_in - floor), I_in the mean luma within sigma / 2 of c,
 //                  I_mid on the ring at sigma: ~0.4-0.7 for a light's bell-shaped profile at its
@@ -49,6 +52,12 @@ struct LightCandidateCheckOptions {
   // funnel may have the funnel in one sector of its ring.)
   double min_peak_drop = 1.0;
   double min_peak_drop_fraction = 0.1;
+  // A saturated core may have a bright structure beside it in a few sectors, not all round it:
+  // the open_sectors-th dimmest sector must drop by min_open_drop_fraction of the contrast (the
+  // edge of a saturated surface has half its ring on the surface; a brighter rim along the edge
+  // gives it ~15 % of its contrast).
+  int open_sectors = 5;
+  double min_open_drop_fraction = 0.4;
   double max_core_radius_sigmas = 2.0;  // a core wider than this is a bright surface
   double max_flatness = 0.85;
   // A light's core is round: an emitting disc seen through round optics (motion blur of a few
@@ -61,6 +70,7 @@ struct LightCandidateCheckOptions {
 struct LightCandidateEvidence {
   double halo_excess = 0.0;
   double peak_drop = 0.0;
+  double open_drop = 0.0;  // core peak - the open_sectors-th dimmest sector's mean luma
   bool at_border = false;
   double flatness = 0.0;
   bool saturated = false;
