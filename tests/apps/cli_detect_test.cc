@@ -45,8 +45,10 @@ struct Footage {
   std::vector<std::vector<std::pair<int, Eigen::Vector2d>>> truth;  // per frame: id, pixel
 };
 
-// Frames of the ring, the camera looking down from 3 m, drifting and turning slowly.
-void MakeFootage(Footage* footage, int frames) {
+// Frames of the ring, the camera looking down from 3 m, drifting and turning slowly. With
+// faded_light, that light is a dim blue blob from frame 1 on (below the full-image response), and
+// a blue LED that is not the dock's shines beside the ring (a lamp on the deck, say).
+void MakeFootage(Footage* footage, int frames, int faded_light = -1) {
   DockModel dock = LoadDockModel(std::string(AUVDOCK_SOURCE_DIR) + "/data/docks/ring_8.yaml");
   dock.light_colour = "blue";
   SaveDockModel(dock, footage->dir / "dock.yaml");
@@ -62,9 +64,20 @@ void MakeFootage(Footage* footage, int frames) {
     for (const DockLight& light : dock.lights) {
       const Eigen::Vector3d p = T_C_D * light.p_D;
       const Eigen::Vector2d uv(kF * p.x() / p.z() + kCx, kF * p.y() / p.z() + kCy);
-      test::AddLed({uv, 3.0, 7.0}, &image);
       seen.emplace_back(light.id, uv);
+      if (light.id == faded_light && f > 0) {
+        for (int v = 0; v < image.rows; ++v) {
+          for (int u = 0; u < image.cols; ++u) {
+            const double d2 = (u - uv.x()) * (u - uv.x()) + (v - uv.y()) * (v - uv.y());
+            const float w = static_cast<float>(std::exp(-d2 / (2.0 * 2.5 * 2.5)));
+            image.at<cv::Vec3f>(v, u) += cv::Vec3f(150.0f * w, 60.0f * w, 10.0f * w);
+          }
+        }
+        continue;
+      }
+      test::AddLed({uv, 3.0, 7.0}, &image);
     }
+    if (faded_light >= 0) test::AddLed({Eigen::Vector2d(560.0, 420.0), 3.0, 7.0}, &image);
     cv::Mat bgr;
     image.convertTo(bgr, CV_8UC3);
     char name[32];
@@ -129,6 +142,41 @@ TEST(DetectCli, PosesEveryFrameOfASymmetricRingWithConsistentIdentities) {
     EXPECT_EQ(it->second, std::stoi(id)) << "light " << truth << " changed identity: " << line;
   }
   EXPECT_EQ(reported_of_true.size(), 8u);
+}
+
+TEST(DetectCli, TheSecondLookFindsAFadedLightAndTheDropOptionRemovesWhatThePoseDoesNotExplain) {
+  Footage footage;
+  std::filesystem::create_directories(footage.dir / "frames");
+  MakeFootage(&footage, 6, /*faded_light=*/2);
+  const std::string with = footage.dir / "with";
+  test::CommandResult r = test::RunAuvdock(DetectArgs(footage, with));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  nlohmann::json summary = nlohmann::json::parse(test::ReadTextFile(with + "/summary.json"));
+  EXPECT_EQ(summary["frames_with_pose"], 6);
+  EXPECT_EQ(summary["labels"]["recall"], 1.0);
+  EXPECT_EQ(summary["second_look"]["guided_detections"], 5);
+  EXPECT_LT(summary["labels"]["precision"].get<double>(), 1.0);  // the lamp beside the ring
+
+  const std::string without = footage.dir / "without";
+  std::vector<std::string> args = DetectArgs(footage, without);
+  args.push_back("--no-second-look");
+  r = test::RunAuvdock(args);
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  summary = nlohmann::json::parse(test::ReadTextFile(without + "/summary.json"));
+  EXPECT_NEAR(summary["labels"]["recall"].get<double>(), 1.0 - 5.0 / 48.0, 1e-9);
+  EXPECT_EQ(summary["second_look"]["guided_detections"], 0);
+
+  const std::string dropped = footage.dir / "dropped";
+  args = DetectArgs(footage, dropped);
+  args.push_back("--drop-unexplained");
+  r = test::RunAuvdock(args);
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  summary = nlohmann::json::parse(test::ReadTextFile(dropped + "/summary.json"));
+  EXPECT_EQ(summary["labels"]["recall"], 1.0);
+  EXPECT_EQ(summary["labels"]["precision"], 1.0);
+  EXPECT_EQ(summary["rejected_candidates"]["not a light of the dock at the pose"], 6);
+  EXPECT_NE(test::ReadTextFile(dropped + "/rejected.csv").find("not a light of the dock"),
+            std::string::npos);
 }
 
 TEST(DetectCli, GravityResolvesAnUprightRing) {
