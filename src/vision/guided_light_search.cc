@@ -63,6 +63,24 @@ std::vector<PredictedLight> PredictLights(const DockModel& dock, const PinholeRa
   return out;
 }
 
+double ObservedSizeRatio(const DockModel& dock, const PinholeRadtanCamera& camera,
+                         const Pose3& T_C_D, const std::vector<LightDetection>& detections,
+                         const std::vector<int>& light_ids) {
+  const std::vector<PredictedLight> predicted =
+      PredictLights(dock, camera, T_C_D, Eigen::Matrix<double, 6, 6>::Zero(), {});
+  std::vector<double> ratios;
+  for (size_t i = 0; i < detections.size() && i < light_ids.size(); ++i) {
+    for (const PredictedLight& p : predicted) {
+      if (p.light_id == light_ids[i] && p.radius_px > 0.0) {
+        ratios.push_back(detections[i].radius_px / p.radius_px);
+      }
+    }
+  }
+  if (ratios.empty()) return 1.0;
+  std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
+  return ratios[ratios.size() / 2];
+}
+
 GuidedLightSearch::GuidedLightSearch(const BlobLightDetectorOptions& full_image_options,
                                      const GuidedLightSearchOptions& options)
     : detector_options_(full_image_options), options_(options) {

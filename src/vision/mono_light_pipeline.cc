@@ -151,22 +151,10 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
     std::vector<PredictedLight> predictions =
         PredictLights(dock_, camera_.intrinsics, *frame.pose.T_C_D, frame.pose.covariance_local,
                       IdentifiedIds(frame.pose.light_ids));
-    // The lights' size as this image shows them (a dock file's radius_m need not be the glow's):
-    // the median ratio of the identified lights' radii to their predicted ones.
-    std::vector<double> ratios;
-    const std::vector<PredictedLight> seen = PredictLights(
-        dock_, camera_.intrinsics, *frame.pose.T_C_D, Eigen::Matrix<double, 6, 6>::Zero(), {});
-    for (size_t i = 0; i < frame.detections.size(); ++i) {
-      for (const PredictedLight& p : seen) {
-        if (p.light_id == frame.pose.light_ids[i] && p.radius_px > 0.0) {
-          ratios.push_back(frame.detections[i].radius_px / p.radius_px);
-        }
-      }
-    }
-    if (!ratios.empty()) {
-      std::nth_element(ratios.begin(), ratios.begin() + ratios.size() / 2, ratios.end());
-      for (PredictedLight& p : predictions) p.radius_px *= ratios[ratios.size() / 2];
-    }
+    // The lights' size as this image shows them (a dock file's radius_m need not be the glow's).
+    const double size = ObservedSizeRatio(dock_, camera_.intrinsics, *frame.pose.T_C_D,
+                                          frame.detections, frame.pose.light_ids);
+    for (PredictedLight& p : predictions) p.radius_px *= size;
     for (const GuidedDetection& g : pose_search_.Search(image, predictions, frame.detections, halo)) {
       frame.detections.push_back(g.detection);
       frame.pose.light_ids.push_back(g.light_id);

@@ -29,6 +29,7 @@ PaperBaselinePipeline::PaperBaselinePipeline(const Calibration& calibration,
                                              const PaperBaselineOptions& options)
     : calibration_(calibration), dock_(dock), options_(options), detector_(options.detector),
       blob_detector_(WithDockColour(options.blob_detector, dock)),
+      guided_search_(WithDockColour(options.blob_detector, dock), options.guided),
       colour_learners_{HaloColourLearner(options.blob_detector.checks.min_halo_excess),
                        HaloColourLearner(options.blob_detector.checks.min_halo_excess),
                        HaloColourLearner(options.blob_detector.checks.min_halo_excess)},
@@ -241,6 +242,36 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
     colour_learners_[0].Observe(frame.left.detections, frame.left.light_ids);
     colour_learners_[1].Observe(frame.right.detections, frame.right.light_ids);
     colour_learners_[2].Observe(frame.mono.detections, frame.mono.light_ids);
+  }
+  if (options_.detector_kind == LightDetectorKind::kBlob && options_.guided_search && frame.T_D_B) {
+    const std::array<std::pair<const CameraCalibration*, const cv::Mat*>, 3> cameras = {
+        std::make_pair(left_, &left), std::make_pair(right_, &right), std::make_pair(mono_, &mono)};
+    std::array<CameraObservation*, 3> observations = {&frame.left, &frame.right, &frame.mono};
+    const double s2 = options_.guided_pose_sigma_px * options_.guided_pose_sigma_px;
+    for (int c = 0; c < 3; ++c) {
+      const auto [camera, image] = cameras[c];
+      if (!camera || image->empty()) continue;
+      CameraObservation& obs = *observations[c];
+      std::vector<int> identified;
+      for (int id : obs.light_ids) {
+        if (id >= 0) identified.push_back(id);
+      }
+      const Pose3 T_C_D = (*frame.T_D_B * camera->T_B_C).Inverse();
+      std::vector<PredictedLight> predictions = PredictLights(
+          dock_, camera->intrinsics, T_C_D, Eigen::Matrix<double, 6, 6>::Zero(), identified);
+      const double size =
+          ObservedSizeRatio(dock_, camera->intrinsics, T_C_D, obs.detections, obs.light_ids);
+      for (PredictedLight& p : predictions) {
+        p.covariance = s2 * Eigen::Matrix2d::Identity();
+        p.radius_px *= size;
+      }
+      for (const GuidedDetection& g : guided_search_.Search(*image, predictions, obs.detections,
+                                                            colour_learners_[c].threshold())) {
+        obs.detections.push_back(g.detection);
+        obs.light_ids.push_back(g.light_id);
+        ++obs.guided;
+      }
+    }
   }
   return frame;
 }

@@ -11,7 +11,9 @@
 #include "auvdock/geometry/so3.h"
 #include "auvdock/sim/image_blobs.h"
 #include "auvdock/vision/guided_light_search.h"
+#include "auvdock/io/calibration.h"
 #include "auvdock/vision/mono_light_pipeline.h"
+#include "auvdock/vision/paper_baseline_pipeline.h"
 #include "tests/testing/dock_views.h"
 
 namespace auvdock {
@@ -256,6 +258,40 @@ TEST(MonoLightPipeline, ATrackedPoseFindsTheLightThatFaded) {
     EXPECT_LT((frame2.detections[i].uv - dim_uv).norm(), std::max(0.5, 3.0 * stated)) << stated;
   }
   EXPECT_TRUE(found);
+}
+
+// The per-frame pipeline of `run` (blob detector): after the frame's pose, each camera gets a
+// second look where the pose puts the lights it missed (step 6).
+TEST(PaperBaselinePipeline, TheSecondLookAddsADimLightWithItsIdentity) {
+  Calibration calibration;
+  calibration.cameras.push_back(MonoCalibration());
+  calibration.cameras.back().role = CameraRole::kMono;
+  const DockModel dock = test::LoadDock("t_shape.yaml");
+  const PinholeRadtanCamera& camera = calibration.cameras.back().intrinsics;
+  const Pose3 T_C_D = ViewFromAbove(4.0);
+  std::vector<std::pair<int, double>> lights;
+  for (size_t i = 0; i < dock.lights.size(); ++i) {
+    lights.emplace_back(dock.lights[i].id, i == 3 ? 35.0 : 180.0);
+  }
+  const cv::Mat image = DrawLights(Background(camera, 11), dock, camera, T_C_D, lights, 3.0, 11);
+  const Pose3 T_D_B = T_C_D.Inverse();  // T_B_C is the identity
+  for (const bool second_look : {false, true}) {
+    PaperBaselineOptions options;
+    options.detector_kind = LightDetectorKind::kBlob;
+    options.guided_search = second_look;
+    PaperBaselinePipeline pipeline(calibration, dock, options);
+    const BaselineFrame frame = pipeline.Process(0, cv::Mat(), cv::Mat(), image, T_D_B);
+    ASSERT_TRUE(frame.T_D_B.has_value()) << frame.reason;
+    int dim_found = 0;
+    const Eigen::Vector2d dim_uv = *camera.Project(T_C_D * dock.lights[3].p_D);
+    for (size_t i = 0; i < frame.mono.detections.size(); ++i) {
+      if (frame.mono.light_ids[i] != dock.lights[3].id) continue;
+      ++dim_found;
+      EXPECT_LT((frame.mono.detections[i].uv - dim_uv).norm(), 0.5);
+    }
+    EXPECT_EQ(dim_found, second_look ? 1 : 0);
+    EXPECT_EQ(frame.mono.guided, second_look ? 1 : 0);
+  }
 }
 
 }  // namespace

@@ -56,6 +56,13 @@ std::vector<PredictedLight> PredictLights(const DockModel& dock, const PinholeRa
                                           const std::vector<int>& skip_ids,
                                           double margin_px = 2.0, double min_depth_m = 0.05);
 
+// How much larger the identified lights look than the dock's radius_m makes them at T_C_D: the
+// median over the identified detections (light_ids[i] >= 0) of radius_px / predicted radius
+// (the glow, not the emitting disc, sets a light's blob size); 1 with none.
+double ObservedSizeRatio(const DockModel& dock, const PinholeRadtanCamera& camera,
+                         const Pose3& T_C_D, const std::vector<LightDetection>& detections,
+                         const std::vector<int>& light_ids);
+
 struct GuidedLightSearchOptions {
   double gate_sigmas = 3.0;
   double gate_floor_px = 1.5;  // the light's own centroid error and the pose's unmodelled error

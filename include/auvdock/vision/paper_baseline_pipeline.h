@@ -40,6 +40,12 @@
 //      Both: the paper's post-hoc weighted average, weights by the number of lights each
 //      camera system sees, w_s = n_s / (n_s + n_m): position averaged, rotation by slerp.
 //      Neither: no pose ("pause the pose estimate").
+//   6. second look (kBlob, guided_search): with the fused pose of step 5, each camera's dock
+//      lights that it projects where no detection is are searched for in that image
+//      (GuidedLightSearch, each prediction's covariance guided_pose_sigma_px^2 I, its size
+//      scaled by the identified lights' ObservedSizeRatio) and added
+//      with their identity (CameraObservation::guided); the frame's poses are not re-solved
+//      (the estimator fuses the added lights).
 // Frames: D dock (z down), B body, C camera (OpenCV). Units: metres, radians, pixels.
 #pragma once
 
@@ -56,6 +62,7 @@
 #include "auvdock/io/calibration.h"
 #include "auvdock/io/measurements.h"
 #include "auvdock/vision/blob_light_detector.h"
+#include "auvdock/vision/guided_light_search.h"
 #include "auvdock/vision/halo_colour_learner.h"
 #include "auvdock/vision/light_detector.h"
 #include "auvdock/vision/ransac_matcher.h"
@@ -87,6 +94,9 @@ struct PaperBaselineOptions {
   bool use_tracking = true;
   double tracking_max_age_s = 0.5;  // a previous pose older than this predicts nothing
   TrackingMatcherOptions tracking;
+  bool guided_search = true;          // step 6 (kBlob only)
+  GuidedLightSearchOptions guided;
+  double guided_pose_sigma_px = 1.5;  // the fused per-frame pose's error at a light, 1 sigma
   uint64_t seed = 1;          // the matcher's random subsets (deterministic)
 };
 
@@ -98,6 +108,7 @@ struct CameraObservation {
   std::string reason;
   std::string symmetry;  // how a symmetric dock's pose was chosen (empty: not symmetric)
   bool tracked = false;  // identified by prediction (tracking) rather than from scratch
+  int guided = 0;        // detections added by the second look (step 6), at the end
   int num_identified() const;
 };
 
@@ -160,6 +171,7 @@ class PaperBaselinePipeline {
   PaperBaselineOptions options_;
   LightDetector detector_;
   BlobLightDetector blob_detector_;
+  GuidedLightSearch guided_search_;
   std::array<HaloColourLearner, 3> colour_learners_;  // left, right, mono
   std::mt19937_64 rng_;
   std::optional<Pose3> last_T_D_B_;  // the previous reported pose, for tracking
