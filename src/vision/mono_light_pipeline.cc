@@ -77,14 +77,19 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
   const auto t1 = Clock::now();
   // 3. Identification and pose; step 2's guesses serve tracking only: those it did not identify
   // go, and when it did not track, the first pass's detections are identified from scratch.
-  frame.pose = poser_.Process(frame.detections);
   const bool guessed = static_cast<int>(frame.detections.size()) > frame.first_pass_detections;
-  if (guessed && !frame.pose.tracked) {
-    frame.detections.resize(frame.first_pass_detections);
-    frame.pose = poser_.Retry(frame.detections);
+  if (guessed) {
+    frame.pose = poser_.ProcessTrackedOnly(frame.detections);
+    if (!frame.pose.T_C_D) {
+      frame.detections.resize(frame.first_pass_detections);
+      frame.pose = poser_.Retry(frame.detections);
+    }
+  } else {
+    frame.pose = poser_.Process(frame.detections);
   }
   const auto t2 = Clock::now();
-  if (guessed && frame.pose.tracked) {
+  if (guessed && frame.pose.tracked &&
+      static_cast<int>(frame.detections.size()) > frame.first_pass_detections) {
     std::vector<LightDetection> kept;
     std::vector<int> ids;
     for (size_t i = 0; i < frame.detections.size(); ++i) {

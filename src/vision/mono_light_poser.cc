@@ -14,11 +14,16 @@ MonoLightPoser::MonoLightPoser(const CameraCalibration& camera, const DockModel&
 
 MonoPoseResult MonoLightPoser::Process(const std::vector<LightDetection>& detections) {
   ++frames_since_pose_;
-  return Solve(detections);
+  return Solve(detections, /*from_scratch=*/true);
+}
+
+MonoPoseResult MonoLightPoser::ProcessTrackedOnly(const std::vector<LightDetection>& detections) {
+  ++frames_since_pose_;
+  return Solve(detections, /*from_scratch=*/false);
 }
 
 MonoPoseResult MonoLightPoser::Retry(const std::vector<LightDetection>& detections) {
-  return Solve(detections);
+  return Solve(detections, /*from_scratch=*/true);
 }
 
 std::optional<Pose3> MonoLightPoser::TrackedPose() const {
@@ -29,7 +34,8 @@ std::optional<Pose3> MonoLightPoser::TrackedPose() const {
   return last_T_C_D_;
 }
 
-MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detections) {
+MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detections,
+                                     bool from_scratch) {
   MonoPoseResult result;
   result.light_ids.assign(detections.size(), -1);
 
@@ -69,6 +75,10 @@ MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detectio
       result.tracked = true;
       start = last_T_C_D_;
     }
+  }
+  if (!result.tracked && !from_scratch) {
+    result.reason = can_track ? "tracking: " + match.reason : "nothing to track";
+    return result;
   }
   if (!result.tracked && static_cast<int>(detections.size()) < options_.min_lights) {
     result.reason = "only " + std::to_string(detections.size()) + " detections (need " +

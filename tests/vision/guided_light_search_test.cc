@@ -9,9 +9,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "auvdock/geometry/so3.h"
+#include "auvdock/io/calibration.h"
 #include "auvdock/sim/image_blobs.h"
 #include "auvdock/vision/guided_light_search.h"
-#include "auvdock/io/calibration.h"
 #include "auvdock/vision/mono_light_pipeline.h"
 #include "auvdock/vision/paper_baseline_pipeline.h"
 #include "tests/testing/dock_views.h"
@@ -258,6 +258,37 @@ TEST(MonoLightPipeline, ATrackedPoseFindsTheLightThatFaded) {
     EXPECT_LT((frame2.detections[i].uv - dim_uv).norm(), std::max(0.5, 3.0 * stated)) << stated;
   }
   EXPECT_TRUE(found);
+}
+
+// Guesses only tracking may label: a failed tracked-only frame identifies nothing from scratch
+// and leaves the tracking state as it was.
+TEST(MonoLightPoser, TrackedOnlyNeverIdentifiesFromScratchNorForgetsTheTrack) {
+  const CameraCalibration camera = MonoCalibration();
+  const DockModel dock = test::LoadDock("t_shape.yaml");
+  std::mt19937_64 rng(3);
+  const Pose3 first = ViewFromAbove(4.0);
+  const test::View view =
+      test::MakeView(dock, camera.intrinsics, first, test::AllLightIds(dock), 0, 0.2, rng);
+  MonoLightPoser fresh(camera, dock);
+  const MonoPoseResult untracked = fresh.ProcessTrackedOnly(view.detections);
+  EXPECT_FALSE(untracked.T_C_D.has_value());
+  EXPECT_EQ(untracked.reason, "nothing to track");
+  ASSERT_TRUE(fresh.Retry(view.detections).T_C_D.has_value());
+
+  MonoLightPoser poser(camera, dock);
+  ASSERT_TRUE(poser.Process(view.detections).T_C_D.has_value());
+  const Pose3 tracked = *poser.TrackedPose();
+  // A view far from the tracked one: tracking cannot label it, and nothing else may.
+  Pose3 elsewhere = ViewFromAbove(6.0);
+  elsewhere.q = ExpQuaternion(Eigen::Vector3d(0.0, 0.0, 1.2)) * elsewhere.q;
+  const test::View other =
+      test::MakeView(dock, camera.intrinsics, elsewhere, test::AllLightIds(dock), 0, 0.2, rng);
+  const MonoPoseResult result = poser.ProcessTrackedOnly(other.detections);
+  EXPECT_FALSE(result.T_C_D.has_value());
+  EXPECT_EQ(result.reason.rfind("tracking: ", 0), 0u) << result.reason;
+  ASSERT_TRUE(poser.TrackedPose().has_value());
+  EXPECT_LT((poser.TrackedPose()->p - tracked.p).norm(), 1e-12);
+  EXPECT_TRUE(poser.Retry(other.detections).T_C_D.has_value());  // from scratch, on request
 }
 
 // The per-frame pipeline of `run` (blob detector): after the frame's pose, each camera gets a

@@ -76,7 +76,11 @@ class MonoLightPoser {
 
   // The next frame's detections.
   MonoPoseResult Process(const std::vector<LightDetection>& detections);
-  // The same frame again with other detections (a second detection pass), when Process gave no
+  // The next frame's detections, identified by tracking only (no identification from scratch):
+  // for detections that include guesses, which only tracking may label. No pose: the state is
+  // as before the frame, and Retry may follow.
+  MonoPoseResult ProcessTrackedOnly(const std::vector<LightDetection>& detections);
+  // The same frame again with other detections (a second detection pass), when the frame gave no
   // pose: the tracking state is that of the frame, not one frame older.
   MonoPoseResult Retry(const std::vector<LightDetection>& detections);
 
@@ -88,7 +92,7 @@ class MonoLightPoser {
   CameraCalibration camera_;
   DockModel dock_;
   MonoLightPoserOptions options_;
-  MonoPoseResult Solve(const std::vector<LightDetection>& detections);
+  MonoPoseResult Solve(const std::vector<LightDetection>& detections, bool from_scratch);
 
   std::mt19937_64 rng_;
   std::optional<Pose3> last_T_C_D_;
