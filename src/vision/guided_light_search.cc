@@ -176,4 +176,29 @@ std::vector<GuidedDetection> GuidedLightSearch::Search(
   return found;
 }
 
+int SearchMissedLights(const GuidedLightSearch& search, const cv::Mat& image,
+                       const DockModel& dock, const PinholeRadtanCamera& camera,
+                       const Pose3& T_C_D, const Eigen::Matrix<double, 6, 6>& covariance_local,
+                       double pixel_sigma_px, double min_halo_excess,
+                       std::vector<LightDetection>* detections, std::vector<int>* light_ids) {
+  std::vector<int> identified;
+  for (int id : *light_ids) {
+    if (id >= 0) identified.push_back(id);
+  }
+  std::vector<PredictedLight> predictions =
+      PredictLights(dock, camera, T_C_D, covariance_local, identified);
+  const double size = ObservedSizeRatio(dock, camera, T_C_D, *detections, *light_ids);
+  for (PredictedLight& p : predictions) {
+    p.covariance += pixel_sigma_px * pixel_sigma_px * Eigen::Matrix2d::Identity();
+    p.radius_px *= size;
+  }
+  int added = 0;
+  for (const GuidedDetection& g : search.Search(image, predictions, *detections, min_halo_excess)) {
+    detections->push_back(g.detection);
+    light_ids->push_back(g.light_id);
+    ++added;
+  }
+  return added;
+}
+
 }  // namespace auvdock

@@ -31,12 +31,23 @@ GuidedLightSearchOptions TrackedSearchOptions(const MonoLightPipelineOptions& op
   return tracked;
 }
 
-std::vector<int> IdentifiedIds(const std::vector<int>& light_ids) {
+// Keeps the detections (and their ids) for which keep(i, id) holds, and counts the kept first-pass
+// ones anew.
+template <typename Keep>
+void KeepDetections(MonoLightFrame* frame, Keep keep) {
+  std::vector<LightDetection> detections;
   std::vector<int> ids;
-  for (int id : light_ids) {
-    if (id >= 0) ids.push_back(id);
+  int first_pass = 0;
+  for (size_t i = 0; i < frame->detections.size(); ++i) {
+    const int id = frame->pose.light_ids[i];
+    if (!keep(static_cast<int>(i), id)) continue;
+    first_pass += static_cast<int>(i) < frame->first_pass_detections;
+    detections.push_back(frame->detections[i]);
+    ids.push_back(id);
   }
-  return ids;
+  frame->detections = std::move(detections);
+  frame->pose.light_ids = std::move(ids);
+  frame->first_pass_detections = first_pass;
 }
 
 }  // namespace
@@ -90,18 +101,10 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
   const auto t2 = Clock::now();
   if (guessed && frame.pose.tracked &&
       static_cast<int>(frame.detections.size()) > frame.first_pass_detections) {
-    std::vector<LightDetection> kept;
-    std::vector<int> ids;
-    for (size_t i = 0; i < frame.detections.size(); ++i) {
-      if (static_cast<int>(i) >= frame.first_pass_detections && frame.pose.light_ids[i] < 0) {
-        continue;
-      }
-      kept.push_back(frame.detections[i]);
-      ids.push_back(frame.pose.light_ids[i]);
-    }
-    frame.guided_detections = static_cast<int>(kept.size()) - frame.first_pass_detections;
-    frame.detections = std::move(kept);
-    frame.pose.light_ids = std::move(ids);
+    const int first_pass = frame.first_pass_detections;
+    KeepDetections(&frame, [&](int i, int id) { return i < first_pass || id >= 0; });
+    frame.guided_detections =
+        static_cast<int>(frame.detections.size()) - frame.first_pass_detections;
   }
   // 4. No pose: once more with laxer thresholds, keeping what the dock model verifies.
   if (!frame.pose.T_C_D && options_.weak_pass &&
@@ -153,36 +156,16 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
   }
   // 5. Where the pose puts the lights still missing.
   if (options_.guided_search && frame.pose.T_C_D) {
-    std::vector<PredictedLight> predictions =
-        PredictLights(dock_, camera_.intrinsics, *frame.pose.T_C_D, frame.pose.covariance_local,
-                      IdentifiedIds(frame.pose.light_ids));
-    // The lights' size as this image shows them (a dock file's radius_m need not be the glow's).
-    const double size = ObservedSizeRatio(dock_, camera_.intrinsics, *frame.pose.T_C_D,
-                                          frame.detections, frame.pose.light_ids);
-    for (PredictedLight& p : predictions) p.radius_px *= size;
-    for (const GuidedDetection& g : pose_search_.Search(image, predictions, frame.detections, halo)) {
-      frame.detections.push_back(g.detection);
-      frame.pose.light_ids.push_back(g.light_id);
-      ++frame.guided_detections;
-    }
+    frame.guided_detections += SearchMissedLights(
+        pose_search_, image, dock_, camera_.intrinsics, *frame.pose.T_C_D,
+        frame.pose.covariance_local, 0.0, halo, &frame.detections, &frame.pose.light_ids);
   }
   // 6. What the pose does not explain is not a light of the dock.
   if (frame.pose.T_C_D && !options_.keep_unexplained) {
-    std::vector<LightDetection> kept;
-    std::vector<int> ids;
-    int kept_first_pass = 0;
     for (size_t i = 0; i < frame.detections.size(); ++i) {
-      if (frame.pose.light_ids[i] < 0) {
-        frame.unexplained.push_back(frame.detections[i]);
-        continue;
-      }
-      kept_first_pass += static_cast<int>(i) < frame.first_pass_detections;
-      kept.push_back(frame.detections[i]);
-      ids.push_back(frame.pose.light_ids[i]);
+      if (frame.pose.light_ids[i] < 0) frame.unexplained.push_back(frame.detections[i]);
     }
-    frame.detections = std::move(kept);
-    frame.pose.light_ids = std::move(ids);
-    frame.first_pass_detections = kept_first_pass;
+    KeepDetections(&frame, [](int, int id) { return id >= 0; });
   }
   frame.detect_s = Seconds(t0, t1) + Seconds(t2, Clock::now()) - frame.identify_s;
   frame.identify_s += Seconds(t1, t2);

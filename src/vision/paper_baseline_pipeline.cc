@@ -247,30 +247,16 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
     const std::array<std::pair<const CameraCalibration*, const cv::Mat*>, 3> cameras = {
         std::make_pair(left_, &left), std::make_pair(right_, &right), std::make_pair(mono_, &mono)};
     std::array<CameraObservation*, 3> observations = {&frame.left, &frame.right, &frame.mono};
-    const double s2 = options_.guided_pose_sigma_px * options_.guided_pose_sigma_px;
     for (int c = 0; c < 3; ++c) {
       const auto [camera, image] = cameras[c];
       if (!camera || image->empty()) continue;
       CameraObservation& obs = *observations[c];
-      std::vector<int> identified;
-      for (int id : obs.light_ids) {
-        if (id >= 0) identified.push_back(id);
-      }
-      const Pose3 T_C_D = (*frame.T_D_B * camera->T_B_C).Inverse();
-      std::vector<PredictedLight> predictions = PredictLights(
-          dock_, camera->intrinsics, T_C_D, Eigen::Matrix<double, 6, 6>::Zero(), identified);
-      const double size =
-          ObservedSizeRatio(dock_, camera->intrinsics, T_C_D, obs.detections, obs.light_ids);
-      for (PredictedLight& p : predictions) {
-        p.covariance = s2 * Eigen::Matrix2d::Identity();
-        p.radius_px *= size;
-      }
-      for (const GuidedDetection& g : guided_search_.Search(*image, predictions, obs.detections,
-                                                            colour_learners_[c].threshold())) {
-        obs.detections.push_back(g.detection);
-        obs.light_ids.push_back(g.light_id);
-        ++obs.guided;
-      }
+      obs.guided = SearchMissedLights(guided_search_, *image, dock_, camera->intrinsics,
+                                      (*frame.T_D_B * camera->T_B_C).Inverse(),
+                                      Eigen::Matrix<double, 6, 6>::Zero(),
+                                      options_.guided_pose_sigma_px,
+                                      colour_learners_[c].threshold(), &obs.detections,
+                                      &obs.light_ids);
     }
   }
   return frame;

@@ -105,4 +105,14 @@ class GuidedLightSearch {
   GuidedLightSearchOptions options_;
 };
 
+// The second look after a pose, as the pipelines use it: the dock's lights not in *light_ids,
+// predicted by T_C_D with covariance J P_local J^T + pixel_sigma_px^2 I and sizes scaled by the
+// identified lights' ObservedSizeRatio, searched for in image; each found light is appended to
+// *detections and *light_ids. Returns how many were appended.
+int SearchMissedLights(const GuidedLightSearch& search, const cv::Mat& image,
+                       const DockModel& dock, const PinholeRadtanCamera& camera,
+                       const Pose3& T_C_D, const Eigen::Matrix<double, 6, 6>& covariance_local,
+                       double pixel_sigma_px, double min_halo_excess,
+                       std::vector<LightDetection>* detections, std::vector<int>* light_ids);
+
 }  // namespace auvdock
