@@ -29,6 +29,7 @@ struct RunOptions {
   std::string config;
   bool quiet = false;
   std::string detector = "contrast";
+  double sync_tolerance_ms = -1.0;  // < 0: half the shortest frame interval
 };
 
 using Clock = std::chrono::steady_clock;
@@ -40,7 +41,8 @@ void Run(const RunOptions& options) {
   std::vector<std::string> skipped_rows;
   const Dataset dataset = LoadDataset(options.dataset, &skipped_rows);
   if (!dataset.calibration.imu) throw InputError(options.dataset + ": calibration has no IMU");
-  VisionFrameSource source(dataset, ParseDetectorKind(options.detector));
+  VisionFrameSource source(dataset, ParseDetectorKind(options.detector),
+                           SyncToleranceNs(options.sync_tolerance_ms));
   SlidingWindowEstimator estimator(dataset.calibration, *dataset.dock, config.estimator);
   GoNoGo go_no_go(config.go_no_go);
   EstimateWriter writer(options.out);
@@ -61,7 +63,7 @@ void Run(const RunOptions& options) {
   try {
     while (const std::optional<VisionFrame> frame = source.Next(predict)) {
       const auto t0 = Clock::now();
-      while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= frame->t_ns) {
+      while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= frame->last_t_ns()) {
         estimator.AddImu(dataset.imu[next_imu++]);
       }
       const std::optional<EstimatorOutput> out = estimator.AddVisionFrame(*frame);
@@ -116,6 +118,9 @@ void AddRunCommand(CLI::App& root) {
   sub->add_option("--config", options->config, "Estimator and go/no-go options (YAML)");
   sub->add_option("--detector", options->detector,
                   "contrast (default: developed on our renders) or blob (real water)");
+  sub->add_option("--sync-tolerance-ms", options->sync_tolerance_ms,
+                  "Images of different cameras this close in time share one state (default: half "
+                  "the shortest frame interval; 0: equal time stamps only)");
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { Run(*options); });
 }

@@ -28,6 +28,7 @@ struct SmoothOptions {
   std::string config;
   bool quiet = false;
   std::string detector = "contrast";
+  double sync_tolerance_ms = -1.0;  // < 0: half the shortest frame interval
 };
 
 using Clock = std::chrono::steady_clock;
@@ -39,7 +40,8 @@ void Smooth(const SmoothOptions& options) {
   std::vector<std::string> skipped_rows;
   const Dataset dataset = LoadDataset(options.dataset, &skipped_rows);
   if (!dataset.calibration.imu) throw InputError(options.dataset + ": calibration has no IMU");
-  VisionFrameSource source(dataset, ParseDetectorKind(options.detector));
+  VisionFrameSource source(dataset, ParseDetectorKind(options.detector),
+                           SyncToleranceNs(options.sync_tolerance_ms));
   SlidingWindowEstimator estimator(dataset.calibration, *dataset.dock, config.estimator);
   EstimateWriter writer(options.out);
 
@@ -58,7 +60,7 @@ void Smooth(const SmoothOptions& options) {
   while (std::optional<VisionFrame> frame = source.Next(predict)) {
     cancel.ThrowIfCancelled();
     const auto t0 = Clock::now();
-    while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= frame->t_ns) {
+    while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= frame->last_t_ns()) {
       estimator.AddImu(dataset.imu[next_imu++]);
     }
     estimator.AddVisionFrame(*frame);
@@ -130,6 +132,9 @@ void AddSmoothCommand(CLI::App& root) {
   sub->add_option("--config", options->config, "Estimator and go/no-go options (YAML)");
   sub->add_option("--detector", options->detector,
                   "contrast (default: developed on our renders) or blob (real water)");
+  sub->add_option("--sync-tolerance-ms", options->sync_tolerance_ms,
+                  "Images of different cameras this close in time share one state (default: half "
+                  "the shortest frame interval; 0: equal time stamps only)");
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { Smooth(*options); });
 }

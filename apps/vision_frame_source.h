@@ -2,6 +2,14 @@
 // order, decodes the images (an unreadable or wrong-size image is skipped with a warning) and
 // runs the per-frame vision pipeline (detect, identify, triangulate) into the estimator's
 // VisionFrame. Times decoding and the front-end separately.
+//
+// Cameras that are not synchronised with each other: the images of one frame are the earliest
+// image not yet used (at t0) and, of every other camera, its next image within the sync tolerance
+// after t0 (by default half the shortest camera's median frame interval, so each image joins the
+// frame nearest to it). The frame's state is at t0; each camera's lag behind t0 goes to the
+// VisionFrame (mono_dt_ns, stereo_dt_ns) and the estimator moves its observations to t0 with the
+// IMU. The stereo pair is triangulated as one exposure: when its two images are more than 1 ms
+// apart, a warning says so. A synchronised rig gives the frames it always did.
 #pragma once
 
 #include <array>
@@ -9,7 +17,7 @@
 #include <functional>
 #include <map>
 #include <optional>
-#include <set>
+#include <vector>
 
 #include "auvdock/estimator/vision_frame.h"
 #include "auvdock/io/dataset.h"
@@ -19,12 +27,17 @@ namespace auvdock::cli {
 
 // "contrast" or "blob" (the --detector option); throws InputError otherwise.
 LightDetectorKind ParseDetectorKind(const std::string& name);
+// The --sync-tolerance-ms option in ns: < 0 (the default) stays < 0; NaN/Inf throw InputError.
+int64_t SyncToleranceNs(double milliseconds);
 
 class VisionFrameSource {
  public:
   // Throws InputError when the dataset has no dock or no camera frames.
+  // sync_tolerance_ns < 0: the default above; 0: only images with equal time stamps share a
+  // frame.
   explicit VisionFrameSource(const Dataset& dataset,
-                             LightDetectorKind detector = LightDetectorKind::kContrast);
+                             LightDetectorKind detector = LightDetectorKind::kContrast,
+                             int64_t sync_tolerance_ns = -1);
 
   // A body pose T_D_B predicted for a frame time (the estimator's IMU propagation), or nothing.
   using Predictor = std::function<std::optional<Pose3>(int64_t t_ns)>;
@@ -37,21 +50,29 @@ class VisionFrameSource {
   // Frames that gave the estimator no vision, counted by the pipeline's reason.
   const std::map<std::string, int>& no_vision_reasons() const { return no_vision_reasons_; }
 
-  size_t num_frames() const { return times_.size(); }
-  int64_t first_t_ns() const { return *times_.begin(); }
-  int64_t last_t_ns() const { return *times_.rbegin(); }
+  size_t num_frames() const { return frames_.size(); }
+  int64_t first_t_ns() const { return frames_.front().t_ns; }
+  int64_t last_t_ns() const { return frames_.back().t_ns; }
+  int64_t sync_tolerance_ns() const { return sync_tolerance_ns_; }
   double decode_s() const { return decode_s_; }
   double frontend_s() const { return frontend_s_; }
   int unreadable_images() const { return unreadable_images_; }
 
  private:
+  // One frame's images: stereo left, stereo right, mono (null: none).
+  struct FrameImages {
+    int64_t t_ns = 0;
+    std::array<const CameraFrame*, 3> images{};
+  };
+
   PaperBaselinePipeline pipeline_;
   std::array<const CameraCalibration*, 3> cameras_{};
-  std::array<std::map<int64_t, const CameraFrame*>, 3> frames_by_time_;
-  std::set<int64_t> times_;
-  std::set<int64_t>::const_iterator next_;
+  int64_t sync_tolerance_ns_ = 0;
+  std::vector<FrameImages> frames_;
+  size_t next_ = 0;
   double decode_s_ = 0.0, frontend_s_ = 0.0;
   int unreadable_images_ = 0;
+  bool warned_unsynchronised_pair_ = false;
   std::map<std::string, int> no_vision_reasons_;
 };
 

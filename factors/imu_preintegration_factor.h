@@ -38,6 +38,7 @@
 #pragma once
 
 #include <stdexcept>
+#include <string>
 
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/sized_cost_function.h>
@@ -83,7 +84,9 @@ class ImuPreintegrationFactor final
     const Eigen::LLT<Matrix15> llt(covariance_);
     if (llt.info() != Eigen::Success) {
       throw std::invalid_argument(
-          "ImuPreintegrationFactor: covariance is not positive definite (zero noise densities?)");
+          "ImuPreintegrationFactor: covariance is not positive definite (zero noise densities?) "
+          "over " + std::to_string(dt) + " s, " + std::to_string(preintegration_.num_samples()) +
+          " samples");
     }
     sqrt_info_ = llt.matrixL().solve(Matrix15::Identity());
   }

@@ -28,7 +28,7 @@ while [[ $# -gt 0 ]]; do
     *) echo "evaluate_detector.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
-bin=build/bin/auvdock
+bin=${AUVDOCK_BIN:-build/bin/auvdock}   # another build: AUVDOCK_BIN=path/to/auvdock
 [[ -x "$bin" ]] || { echo "evaluate_detector.sh: $bin not found: run scripts/build.sh" >&2; exit 2; }
 mkdir -p "$out"
 for seed in $seeds; do

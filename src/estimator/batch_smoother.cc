@@ -146,7 +146,11 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     }
     const auto f = frame_at.find(s->t_ns);
     if (f != frame_at.end()) {
-      s->vision = AddVisionFactors(&problem, *f->second, rig, vision_options, s->pose,
+      ImuBias bias;
+      bias.gyro = Eigen::Map<const Eigen::Vector3d>(s->bias);
+      bias.accel = Eigen::Map<const Eigen::Vector3d>(s->bias + 3);
+      s->vision = AddVisionFactors(&problem, *f->second, rig, vision_options,
+                                   VisionState(s->pose, s->velocity, &buffer, bias),
                                    &result.stats.skipped_observations);
     }
   }

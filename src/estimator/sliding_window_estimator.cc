@@ -262,7 +262,9 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   vision.correlated_pixel_variance =
       CorrelatedVisionVariance(options_.window_vision_floor_px,
                                options_.window_vision_correlation_time_s, frame_interval_s);
-  state->vision = AddVisionFactors(problem_.get(), frame, rig_, vision, state->pose,
+  state->vision = AddVisionFactors(problem_.get(), frame, rig_, vision,
+                                   VisionState(state->pose, state->velocity, &imu_,
+                                               LoadBias(state->bias)),
                                    &stats_.skipped_observations);
 
   if (!Solve()) {
@@ -297,7 +299,8 @@ void SlidingWindowEstimator::UpdateNoiseScales(const State& state, const Matrix6
     // row-major), the space of the covariance.
     Eigen::Vector3d residual = Eigen::Vector3d::Zero();
     Eigen::Matrix<double, 3, kPoseTangentSize, Eigen::RowMajor> J_buffer;
-    double* jacobians[1] = {J_buffer.data()};
+    // The pose is the first block; a time-shifted residual's second, the velocity, is not needed.
+    double* jacobians[2] = {J_buffer.data(), nullptr};
     double cost = 0.0;
     if (!problem_->EvaluateResidualBlock(r.id, /*apply_loss_function=*/false, &cost,
                                          residual.data(), jacobians)) {

@@ -12,9 +12,12 @@
 #include "factors/mono_reprojection_factor.h"
 #include "factors/pose_manifold.h"
 #include "factors/stereo_point_factor.h"
+#include "factors/time_shifted_factor.h"
 
 namespace auvdock {
 namespace {
+
+constexpr double kZero3[3] = {0.0, 0.0, 0.0};
 
 ceres::LossFunction* WeightedHuber(double huber_sigmas, double weight) {
   ceres::LossFunction* huber = new ceres::HuberLoss(huber_sigmas);
@@ -47,6 +50,38 @@ double Factor(const std::map<int, double>& factors, int light_id) {
   return it == factors.end() ? 1.0 : it->second;
 }
 
+// The IMU's motion from the state's time to an image dt_ns later; an identity shift for dt = 0,
+// nothing when the IMU does not cover the interval.
+std::optional<ImuPoseShift> ShiftTo(const VisionFrame& frame, int64_t dt_ns,
+                                    const VisionState& state, const Eigen::Vector3d& gravity_D) {
+  ImuPoseShift shift;
+  shift.gravity_D = gravity_D;
+  if (dt_ns <= 0) return shift;
+  if (state.imu == nullptr || state.velocity == nullptr) return std::nullopt;
+  const std::optional<ImuPreintegration> pim =
+      state.imu->Preintegrate(frame.t_ns, frame.t_ns + dt_ns, state.bias);
+  if (!pim) return std::nullopt;
+  shift.dt_s = pim->sum_dt();
+  shift.delta_q = pim->delta_q();
+  shift.delta_p = pim->delta_p();
+  return shift;
+}
+
+// Adds `factor` on the state's pose, or through the shift on its pose and velocity.
+template <typename Factor, int kResiduals>
+ceres::ResidualBlockId AddResidual(ceres::Problem* problem, std::unique_ptr<Factor> factor,
+                                   const ImuPoseShift& shift, ceres::LossFunction* loss,
+                                   const VisionState& state) {
+  if (shift.dt_s == 0.0) {
+    return problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<Factor, kResiduals, kPoseSize>(factor.release()), loss,
+        state.pose);
+  }
+  return problem->AddResidualBlock(
+      TimeShiftedFactor<Factor, kResiduals>::Create(std::move(factor), shift), loss, state.pose,
+      state.velocity);
+}
+
 }  // namespace
 
 double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
@@ -62,13 +97,25 @@ double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
 
 std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const VisionFrame& frame,
                                              const VisionRig& rig,
-                                             const VisionFactorOptions& options, double* pose,
-                                             int* n_skipped) {
+                                             const VisionFactorOptions& options,
+                                             const VisionState& state, int* n_skipped) {
   std::vector<VisionResidual> added;
   const bool mono = options.use_mono && rig.mono != nullptr;
   const bool stereo = options.use_stereo && rig.stereo_left != nullptr;
-  const int n_mono = mono ? static_cast<int>(frame.mono.size()) : 0;
-  const int n_stereo = stereo ? static_cast<int>(frame.stereo.size()) : 0;
+  int n_mono = mono ? static_cast<int>(frame.mono.size()) : 0;
+  int n_stereo = stereo ? static_cast<int>(frame.stereo.size()) : 0;
+  // Each image's pose: the state's, moved by the IMU to the image's own time.
+  const std::optional<ImuPoseShift> mono_shift =
+      ShiftTo(frame, frame.mono_dt_ns, state, rig.dock->gravity_D);
+  const std::optional<ImuPoseShift> stereo_shift =
+      ShiftTo(frame, frame.stereo_dt_ns, state, rig.dock->gravity_D);
+  if (!mono_shift) *n_skipped += std::exchange(n_mono, 0);
+  if (!stereo_shift) *n_skipped += std::exchange(n_stereo, 0);
+  double mono_pose[kPoseSize], stereo_pose[kPoseSize];
+  if (mono_shift) mono_shift->Apply(state.pose, state.velocity ? state.velocity : kZero3, mono_pose);
+  if (stereo_shift) {
+    stereo_shift->Apply(state.pose, state.velocity ? state.velocity : kZero3, stereo_pose);
+  }
   const StageWeights weights = StageWeighting(options.stage_weighting).Compute(n_stereo, n_mono);
   // The triangulation covariance is J (sigma^2 I) J^T: adding a variance to every pixel
   // coordinate of the pair scales it.
@@ -92,19 +139,19 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
     // A light behind the camera at the current estimate cannot be evaluated there (the factor
     // returns false, and Ceres fails the whole solve at its initial point): the observation
     // contradicts the prediction and is skipped, as a gate would.
-    if (!(factor->DepthInCamera(pose) > MonoReprojectionFactor::kMinDepth)) {
+    if (!(factor->DepthInCamera(mono_pose) > MonoReprojectionFactor::kMinDepth)) {
       ++*n_skipped;
       continue;
     }
-    const ceres::ResidualBlockId id = problem->AddResidualBlock(
-        MonoReprojectionFactor::Create(std::move(factor)),
-        WeightedHuber(options.huber_sigmas, weights.mono), pose);
+    const ceres::ResidualBlockId id = AddResidual<MonoReprojectionFactor, kMonoResidualSize>(
+        problem, std::move(factor), *mono_shift, WeightedHuber(options.huber_sigmas, weights.mono),
+        state);
     added.push_back({id, true, obs.light_id, weights.mono});
   }
   // The body pose the stereo covariances are evaluated at, once per frame.
   std::optional<Pose3> T_B_D_predicted;
   if (n_stereo > 0 && options.stereo_covariance_at_prediction && rig.stereo_right != nullptr) {
-    T_B_D_predicted = PoseFromBlock(pose).Inverse();
+    T_B_D_predicted = PoseFromBlock(stereo_pose).Inverse();
   }
   for (int i = 0; i < n_stereo; ++i) {
     const StereoLightObservation& obs = frame.stereo[i];
@@ -120,12 +167,13 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
         covariance = *predicted;
       }
     }
-    const ceres::ResidualBlockId id = problem->AddResidualBlock(
-        StereoPointFactor::Create(obs.p_S,
-                                  Factor(options.stereo_variance_factor, obs.light_id) *
-                                      stereo_scale * covariance,
-                                  rig.stereo_left->T_B_C, light->p_D),
-        WeightedHuber(options.huber_sigmas, weights.stereo), pose);
+    const ceres::ResidualBlockId id = AddResidual<StereoPointFactor, kStereoPointResidualSize>(
+        problem,
+        std::make_unique<StereoPointFactor>(
+            obs.p_S,
+            Factor(options.stereo_variance_factor, obs.light_id) * stereo_scale * covariance,
+            rig.stereo_left->T_B_C, light->p_D),
+        *stereo_shift, WeightedHuber(options.huber_sigmas, weights.stereo), state);
     added.push_back({id, false, obs.light_id, weights.stereo});
   }
   return added;

@@ -127,6 +127,13 @@ void ImuPreintegration::Integrate(const Eigen::Vector3d& gyro_B, const Eigen::Ve
   B_a.block<3, 3>(6, 0) = dR * dt2_half;
   covariance_ = A * covariance_ * A.transpose() + var_g * B_g * B_g.transpose() +
                 var_a * B_a * B_a.transpose();
+  // The discrete model makes the piece's dv and dp noise one and the same (rank 3 of 6): a
+  // single piece would give a singular covariance (a frame held past the IMU's last sample).
+  // Continuous white noise over the piece gives Cov(dp) = sigma_c^2 dt^3 / 3, Cov(dv, dp) =
+  // sigma_c^2 dt^2 / 2, Cov(dv) = sigma_c^2 dt: the discrete model has all but sigma_c^2 dt^3 / 12
+  // of Cov(dp) (isotropic, whatever dR).
+  covariance_.block<3, 3>(6, 6).diagonal().array() +=
+      noise_.accelerometer_noise_density * noise_.accelerometer_noise_density * dt * dt * dt / 12.0;
   // Keep it exactly symmetric so the factor's LLT sees the same matrix on both triangles.
   covariance_ = 0.5 * (covariance_ + covariance_.transpose()).eval();
 

@@ -135,6 +135,7 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
   };
 
   const double frame_period_s = 1.0 / s.cameras.rate_hz;
+  const int64_t mono_offset_ns = std::llround(s.cameras.mono_time_offset_s * 1e9);
   for (int64_t k = 0; k < n_frames; ++k) {
     cancel.ThrowIfCancelled();
     const int64_t t = SampleTime(k, s.cameras.rate_hz);
@@ -143,19 +144,21 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
     writer.AddVisibility(visibility);
     summary.stage_duration_s[static_cast<int>(visibility.stage)] += frame_period_s;
     if (s.cameras.render_images) {
-      const Pose3 T_D_B = trajectory_.At(Seconds(t)).T_D_B;
       for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
         const auto& cam = calibration_.cameras[i];
+        // Each camera at its own exposure time (the mono camera may lag the stereo pair).
+        const int64_t t_cam = cam.role == CameraRole::kMono ? t + mono_offset_ns : t;
+        const Pose3 T_D_B = trajectory_.At(Seconds(t_cam)).T_D_B;
         const RenderResult image = renderers_[i].Render(T_D_B * cam.T_B_C, camera_rngs[i]);
-        writer.AddImage(cam.name, t, image.image);
+        writer.AddImage(cam.name, t_cam, image.image);
         std::vector<LightTruth> truth;
         for (const RenderedLight& light : image.lights) {
           truth.push_back({light.light_id, light.uv, light.range_m, light.radius_px, light.peak});
         }
-        writer.AddLightTruth(cam.name, t, truth, cam.intrinsics.width(),
+        writer.AddLightTruth(cam.name, t_cam, truth, cam.intrinsics.width(),
                                  cam.intrinsics.height());
         for (const auto& d : image.distractors) {
-          record_fault(FaultRecord{t, cam.name, d.kind, DistractorDetail(d)});
+          record_fault(FaultRecord{t_cam, cam.name, d.kind, DistractorDetail(d)});
         }
       }
     }

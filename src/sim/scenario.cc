@@ -71,6 +71,10 @@ void ReadCameras(const ConfigNode& n, CameraRigConfig* c) {
   c->stereo_p_B = stereo.GetVector<3>("p_B", c->stereo_p_B);
   const ConfigNode mono = n.ChildOrEmpty("mono");
   c->mono_p_B = mono.GetVector<3>("p_B", c->mono_p_B);
+  c->mono_time_offset_s = mono.GetNonNegative("time_offset_s", c->mono_time_offset_s);
+  if (c->mono_time_offset_s * c->rate_hz >= 1.0) {
+    mono.Fail("time_offset_s", "must be below the frame interval 1 / rate_hz");
+  }
 }
 
 void ReadRender(const ConfigNode& n, RenderOptions* r) {

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -129,6 +130,46 @@ TEST_F(EstimatorCli, RunSkipsBadMeasurementsAndCountsThem) {
   const Trajectory poses = ReadTumTrajectory(out + "/trajectory.tum");
   EXPECT_GE(poses.size(), 25u);
   ExpectFinitePoses(poses);
+}
+
+// Cameras not synchronised with each other: the mono camera's time stamps moved 37 ms later.
+// Each mono image joins the stereo pair's frame before it (one state per frame, as before); with
+// --sync-tolerance-ms 0 every image time is a frame of its own.
+TEST_F(EstimatorCli, UnsynchronisedCamerasShareOneStatePerFrame) {
+  const std::string ds = *tmp_ / "unsync_ds";
+  fs::copy(dataset_, ds, fs::copy_options::recursive);
+  const std::string csv = ds + "/cam2/data.csv";
+  std::vector<std::string> lines;
+  {
+    std::ifstream in(csv);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+  }
+  ASSERT_EQ(lines.size(), 32u);  // header + 31 images
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const size_t comma = lines[i].find(',');
+    lines[i] = std::to_string(std::stoll(lines[i].substr(0, comma)) + 37000000) +
+               lines[i].substr(comma);
+  }
+  {
+    std::ofstream out(csv);
+    for (const std::string& line : lines) out << line << "\n";
+  }
+  for (const auto& [tolerance, frames] : {std::pair<std::string, int>{"", 31}, {"0", 62}}) {
+    const std::string out = *tmp_ / ("unsync_out" + tolerance);
+    std::vector<std::string> args = {"run", "--dataset", ds, "--out", out, "--quiet"};
+    if (!tolerance.empty()) args.insert(args.end(), {"--sync-tolerance-ms", tolerance});
+    const auto r = test::RunAuvdock(args);
+    ASSERT_EQ(r.exit_status, 0) << r.err;
+    EXPECT_EQ(Summary(out).at("frames").get<int>(), frames) << tolerance;
+    EXPECT_EQ(ReadDecisionsCsv(out + "/decisions.csv").size(), static_cast<size_t>(frames));
+    const Trajectory poses = ReadTumTrajectory(out + "/trajectory.tum");
+    EXPECT_GE(poses.size(), 25u);
+    ExpectFinitePoses(poses);
+  }
+  const auto bad = test::RunAuvdock(
+      {"run", "--dataset", ds, "--out", *tmp_ / "unsync_bad", "--sync-tolerance-ms", "nan"});
+  EXPECT_EQ(bad.exit_status, 2);
+  EXPECT_THAT(bad.err, HasSubstr("--sync-tolerance-ms"));
 }
 
 TEST_F(EstimatorCli, BadOptionsFileIsOneLineExitTwoAndWritesNothing) {

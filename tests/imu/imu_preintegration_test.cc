@@ -308,6 +308,33 @@ TEST(ImuPreintegration, CovarianceGrowsAsTheTextbookFormulasForAStillLevelImu) {
   EXPECT_NEAR(pim.covariance()(6, 3), sa2 * T * T / 2.0, 1e-3 * sa2 * T * T / 2.0);
 }
 
+// One held sample (a frame time just past the IMU's last sample): the discrete model alone
+// makes dv and dp one noise (a singular covariance, which the IMU factor cannot whiten); over
+// the piece the noise is continuous, which gives the exact (dv, dp) covariance and a positive
+// definite whole. Summed over many pieces it is the continuous result without the O(dt) error.
+TEST(ImuPreintegration, OnePieceHasTheContinuousNoiseCovarianceAndIsPositiveDefinite) {
+  ImuNoiseDensities noise;
+  ImuPreintegration pim(noise, ImuBias());
+  const double dt = 0.037;
+  pim.Integrate(Eigen::Vector3d(0.01, -0.02, 0.03), Eigen::Vector3d(0.1, 0.2, -9.81), dt);
+  const double sa2 = noise.accelerometer_noise_density * noise.accelerometer_noise_density;
+  const Eigen::Matrix<double, 9, 9>& P = pim.covariance();
+  const Eigen::LLT<Eigen::Matrix<double, 9, 9>> llt(P);
+  EXPECT_EQ(llt.info(), Eigen::Success);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(P(3 + i, 3 + i), sa2 * dt, 1e-12 * sa2 * dt);
+    EXPECT_NEAR(P(6 + i, 6 + i), sa2 * dt * dt * dt / 3.0, 1e-12 * sa2 * dt * dt * dt);
+    EXPECT_NEAR(P(6 + i, 3 + i), sa2 * dt * dt / 2.0, 1e-12 * sa2 * dt * dt);
+  }
+
+  ImuPreintegration still(noise, ImuBias());
+  const double step = 0.001, T = 2.0;
+  for (int i = 0; i < 2000; ++i) {
+    still.Integrate(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), step);
+  }
+  EXPECT_NEAR(still.covariance()(6, 6), sa2 * T * T * T / 3.0, 1e-9 * sa2 * T * T * T / 3.0);
+}
+
 TEST(ImuPreintegration, RejectsBadInput) {
   ImuNoiseDensities bad = ImuNoiseDensities();
   bad.gyroscope_noise_density = -1.0;

@@ -72,6 +72,17 @@ TEST_F(ScenarioErrors, NonPositiveRateIsRejected) {
               AllOf(HasSubstr(path), HasSubstr("imu.rate_hz"), HasSubstr("positive")));
 }
 
+TEST_F(ScenarioErrors, MonoTimeOffsetMustBeWithinOneFrameInterval) {
+  const std::string path = WriteScenario(
+      "dock: ../docks/t_shape.yaml\ncameras:\n  rate_hz: 10\n  mono: {time_offset_s: 0.1}\n");
+  EXPECT_THAT(ErrorOf([&] { LoadScenario(path); }),
+              AllOf(HasSubstr(path), HasSubstr("cameras.mono.time_offset_s"),
+                    HasSubstr("frame interval")));
+  EXPECT_DOUBLE_EQ(LoadScenario(test::SourcePath("data/scenarios/unsynchronised.yaml"))
+                       .cameras.mono_time_offset_s,
+                   0.037);
+}
+
 TEST_F(ScenarioErrors, WrongTypeIsRejected) {
   const std::string path = WriteScenario("dock: ../docks/t_shape.yaml\nduration_s: long\n");
   EXPECT_THAT(ErrorOf([&] { LoadScenario(path); }),

@@ -43,16 +43,21 @@ TEST(DockingSimulator, SameSeedGivesByteIdenticalOutputAndOtherSeedsDiffer) {
   EXPECT_EQ(a.at("groundtruth.tum"), c.at("groundtruth.tum"));  // the trajectory is the scenario's
 }
 
+// Each image at its camera's own time (here the mono camera 37 ms after the stereo pair), and
+// its labels the lights' projections at that time.
 TEST(DockingSimulator, WritesTheLightsOfEveryImageAsLabels) {
   test::TempDir tmp;
-  const Scenario scenario = test::ShortScenario(1.0);
+  Scenario scenario = test::ShortScenario(1.0);
+  scenario.cameras.mono_time_offset_s = 0.037;
   const DockingSimulator simulator(scenario);
   simulator.Run(tmp.path(), CancellationToken());
   for (const CameraCalibration& camera : simulator.calibration().cameras) {
     const LightLabels labels = LoadLightLabels(tmp / ("groundtruth/" + camera.name + "_lights.csv"));
     ASSERT_EQ(labels.size(), 11u) << camera.name;  // every frame, with or without lights
+    const int64_t offset_ns = camera.role == CameraRole::kMono ? 37000000 : 0;
     for (const auto& [file, frame_labels] : labels) {
       const int64_t t_ns = std::stoll(file.substr(0, file.find('.')));
+      EXPECT_EQ((t_ns - scenario.start_time_ns) % 100000000, offset_ns) << camera.name << file;
       const Pose3 T_D_C = simulator.CameraPose(camera, t_ns);
       ASSERT_TRUE(fs::exists(tmp / (camera.name + "/data/" + file)));
       for (const LightLabel& label : frame_labels) {

@@ -76,9 +76,15 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
             innovation * Eigen::Vector2d(StandardNormal(offset_rng), StandardNormal(offset_rng));
       }
     }
+    // The mono camera's exposure may lag the stereo pair's (cameras.mono_time_offset_s).
+    const int64_t mono_dt_ns =
+        left ? std::llround(scenario.cameras.mono_time_offset_s * 1e9) : int64_t{0};
+    const Pose3 T_D_B_mono =
+        simulator.trajectory().At(simulator.Seconds(t + mono_dt_ns)).T_D_B;
+    frame.mono_dt_ns = mono_dt_ns;
     for (const DockLight& light : run.dock.lights) {
       if (mono) {
-        if (const auto uv = See(*mono, T_D_B, light.p_D, pixel_sigma, rng)) {
+        if (const auto uv = See(*mono, T_D_B_mono, light.p_D, pixel_sigma, rng)) {
           frame.mono.push_back({light.id, *uv + offset[2], pixel_sigma});
         }
       }

@@ -4,6 +4,8 @@
 // seen by both stereo cameras, triangulated from noisy pixels (with their covariance). The
 // per-frame initial pose is the truth perturbed by a few centimetres / degrees when a camera
 // system sees at least 3 lights. For estimator tests and NEES runs (fast: no rendering).
+// With cameras.mono_time_offset_s, the mono pixels are those of the body pose that much later
+// (VisionFrame::mono_dt_ns); the frame, the truth and the stereo points stay at the pair's time.
 #pragma once
 
 #include <cstdint>

@@ -24,6 +24,11 @@
 // Each gets a Huber loss (threshold huber_sigmas on the whitened norm) scaled by the frame's
 // stage weight for its camera system (estimator/stage_weighting.h): the weight multiplies the
 // residual's information, which is the source paper's stage weighting inside the problem.
+// Images later than the state (VisionFrame::mono_dt_ns, stereo_dt_ns > 0: cameras not
+// synchronised with each other) are attached to the state through the IMU's motion over dt
+// (TimeShiftedFactor, factors/time_shifted_factor.h: on the pose and the velocity blocks), so
+// the frame keeps one state and its stage ("both" included). Without IMU coverage of
+// [t, t + dt] that image's observations are skipped.
 // Gating: after a solve, a residual whose squared Mahalanobis distance (without loss or
 // weight) exceeds its chi-square gate is removed.
 #pragma once
@@ -33,6 +38,7 @@
 
 #include <ceres/problem.h>
 
+#include "auvdock/estimator/imu_buffer.h"
 #include "auvdock/estimator/stage_weighting.h"
 #include "auvdock/estimator/vision_frame.h"
 #include "auvdock/geometry/dock_model.h"
@@ -78,13 +84,27 @@ struct VisionRig {
 double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
                                 double frame_interval_s);
 
-// Adds the frame's residuals on `pose` (a block already in the problem). Observations with an
-// unknown light id or non-finite values, and mono observations of a light behind the camera at
-// the pose block's current value, are skipped and counted in *n_skipped.
+// The state a frame's residuals attach to: its pose block and, for images taken after the
+// state's time, its velocity block, the IMU and the bias to preintegrate [t, t + dt] at (the
+// state's current bias estimate). velocity and imu may be null for a synchronised frame.
+struct VisionState {
+  explicit VisionState(double* pose_block, double* velocity_block = nullptr,
+                       const ImuBuffer* imu_buffer = nullptr, const ImuBias& state_bias = {})
+      : pose(pose_block), velocity(velocity_block), imu(imu_buffer), bias(state_bias) {}
+  double* pose;
+  double* velocity;
+  const ImuBuffer* imu;
+  ImuBias bias;
+};
+
+// Adds the frame's residuals on the state's blocks (already in the problem). Observations with
+// an unknown light id or non-finite values, mono observations of a light behind the camera at
+// the current estimate, and observations of an image whose time the IMU does not reach, are
+// skipped and counted in *n_skipped.
 std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const VisionFrame& frame,
                                              const VisionRig& rig,
-                                             const VisionFactorOptions& options, double* pose,
-                                             int* n_skipped);
+                                             const VisionFactorOptions& options,
+                                             const VisionState& state, int* n_skipped);
 
 // Removes the residuals beyond their gate (0 = no gate) from the problem and from *residuals;
 // returns how many.

@@ -6,6 +6,12 @@
 //           stereo-left camera frame (OpenCV axes), with the 3 x 3 covariance from pixel noise.
 // T_D_B_initial is a per-frame pose (the paper's baseline) used only to initialise or re-seed
 // the estimator; it never enters the cost.
+//
+// Time: the frame's state is at t_ns, the time of its earliest image. Cameras that are not
+// synchronised with each other take their images at their own times: the mono image at
+// t_ns + mono_dt_ns, the stereo pair (synchronised with itself) at t_ns + stereo_dt_ns, each
+// >= 0; the estimator moves those observations to the state's time with the IMU
+// (factors/time_shifted_factor.h). Both are 0 for a synchronised rig.
 #pragma once
 
 #include <cstdint>
@@ -35,8 +41,14 @@ struct VisionFrame {
   std::vector<MonoLightObservation> mono;
   std::vector<StereoLightObservation> stereo;
   std::optional<Pose3> T_D_B_initial;
+  int64_t mono_dt_ns = 0;    // mono image time - t_ns
+  int64_t stereo_dt_ns = 0;  // stereo pair time - t_ns
 
   bool empty() const { return mono.empty() && stereo.empty(); }
+  // The time of the frame's latest image: it is complete (and may be used) from then on.
+  int64_t last_t_ns() const {
+    return t_ns + (mono_dt_ns > stereo_dt_ns ? mono_dt_ns : stereo_dt_ns);
+  }
 };
 
 }  // namespace auvdock

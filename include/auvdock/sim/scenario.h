@@ -32,6 +32,9 @@ struct CameraRigConfig {
   double stereo_tilt_deg = 45.0;                                  // below the body x axis
   Eigen::Vector3d stereo_p_B = Eigen::Vector3d(0.9, 0.0, 0.2);    // midpoint of the pair
   Eigen::Vector3d mono_p_B = Eigen::Vector3d(0.75, 0.0, 0.3);
+  // Cameras not synchronised with each other: the mono camera's frames are this long after the
+  // stereo pair's (s, in [0, 1 / rate_hz)); 0 = one trigger for all three.
+  double mono_time_offset_s = 0.0;
   bool render_images = true;
 };
 

@@ -1,0 +1,100 @@
+// A pose factor evaluated at another time than its state: an image taken dt after the state's
+// time t_k (cameras that are not synchronised with each other, estimator/vision_frame.h) is
+// attached to state k through the IMU's motion over [t_k, t_k + dt], so that no extra state is
+// needed for it.
+//
+// Parameter blocks (layout in factors/pose_manifold.h): pose_D_B [7] of state k, v_D [3] of
+// state k (m/s, in D). Constants: the IMU preintegrated over [t_k, t_k + dt] at the state's
+// linearisation bias (dR = R_Bk_Bt, dp in B_k; imu/imu_preintegration.h) and the dock's gravity
+// g_D (m/s^2, in D):
+//
+//   R_D_Bt = R_D_Bk dR
+//   p_D_Bt = p_D_Bk + v_D dt + g_D dt^2 / 2 + R_D_Bk dp
+//
+// which is ImuPreintegration::Predict for the pose; the wrapped factor (any functor with a
+// templated operator()(const T* pose_D_B, T* residuals), e.g. MonoReprojectionFactor or
+// StereoPointFactor) is then evaluated at T_D_Bt. dt >= 0: the state is the earliest image of its
+// frame. What the shift leaves out, and why that is safe for dt up to a frame interval:
+//  - the bias: the shift is held at the bias of the state when the factor is added, so
+//    d(shift)/d(b) is not in the Jacobian; a gyro bias error of 0.01 rad/s moves the attitude by
+//    0.5 mrad over dt = 50 ms, an accelerometer bias error of 0.1 m/s^2 the position by 0.13 mm;
+//  - the IMU noise over dt: its covariance (ImuPreintegration::covariance) is ~1e-8 rad^2 and
+//    ~1e-9 m^2 over 50 ms for a tactical-grade IMU, orders below the vision noise.
+// For a dt of seconds (a late acoustic fix) both grow and an extra state is the better model.
+#pragma once
+
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+#include <ceres/autodiff_cost_function.h>
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "factors/pose_manifold.h"
+
+namespace auvdock {
+
+// The body's motion from a state's time to dt later, from the IMU.
+struct ImuPoseShift {
+  double dt_s = 0.0;
+  Eigen::Quaterniond delta_q = Eigen::Quaterniond::Identity();  // R_Bk_Bt
+  Eigen::Vector3d delta_p = Eigen::Vector3d::Zero();            // m, in B_k
+  Eigen::Vector3d gravity_D = Eigen::Vector3d::Zero();          // m/s^2, in D
+
+  // The pose block at t_k + dt from the state's pose and velocity blocks.
+  template <typename T>
+  void Apply(const T* pose_D_Bk, const T* v_D, T* pose_D_Bt) const {
+    using Vector3T = Eigen::Matrix<T, 3, 1>;
+    const Eigen::Map<const Vector3T> p_k(pose_D_Bk);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_k(pose_D_Bk + 3);
+    const Eigen::Map<const Vector3T> v(v_D);
+    Eigen::Map<Vector3T> p_t(pose_D_Bt);
+    Eigen::Map<Eigen::Quaternion<T>> q_t(pose_D_Bt + 3);
+    const T dt(dt_s);
+    p_t = p_k + v * dt + gravity_D.cast<T>() * T(0.5 * dt_s * dt_s) + q_k * delta_p.cast<T>();
+    q_t = q_k * delta_q.cast<T>();
+  }
+};
+
+template <typename Factor, int kResiduals>
+class TimeShiftedFactor {
+ public:
+  // Throws std::invalid_argument for a negative or non-finite dt or a non-finite shift.
+  TimeShiftedFactor(std::unique_ptr<Factor> factor, const ImuPoseShift& shift)
+      : factor_(std::move(factor)), shift_(shift) {
+    if (!factor_) throw std::invalid_argument("TimeShiftedFactor: no factor");
+    if (!(shift_.dt_s >= 0.0) || !std::isfinite(shift_.dt_s) ||
+        !shift_.delta_q.coeffs().allFinite() || !(shift_.delta_q.norm() > 0.0) ||
+        !shift_.delta_p.allFinite() || !shift_.gravity_D.allFinite()) {
+      throw std::invalid_argument("TimeShiftedFactor: dt must be >= 0 and the shift finite");
+    }
+    shift_.delta_q.normalize();
+  }
+
+  template <typename T>
+  bool operator()(const T* pose_D_Bk, const T* v_D, T* residuals) const {
+    T pose_D_Bt[kPoseSize];
+    shift_.Apply(pose_D_Bk, v_D, pose_D_Bt);
+    return (*factor_)(pose_D_Bt, residuals);
+  }
+
+  // The pose block at the image's time, for the wrapped factor's own queries
+  // (DepthInCamera, SquaredMahalanobis, ...).
+  void ShiftedPose(const double* pose_D_Bk, const double* v_D, double* pose_D_Bt) const {
+    shift_.Apply(pose_D_Bk, v_D, pose_D_Bt);
+  }
+  const Factor& factor() const { return *factor_; }
+  const ImuPoseShift& shift() const { return shift_; }
+
+  static ceres::CostFunction* Create(std::unique_ptr<Factor> factor, const ImuPoseShift& shift) {
+    return new ceres::AutoDiffCostFunction<TimeShiftedFactor, kResiduals, kPoseSize, kVelocitySize>(
+        new TimeShiftedFactor(std::move(factor), shift));
+  }
+
+ private:
+  std::unique_ptr<Factor> factor_;
+  ImuPoseShift shift_;
+};
+
+}  // namespace auvdock
