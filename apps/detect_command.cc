@@ -1,16 +1,16 @@
 // auvdock detect --images "DIR/*.jpg" --calib FILE [--camera NAME] --dock FILE --out DIR
 //                [--overlay] [--labels FILE [--label-max-range M]] [--colour C] [--deinterlace]
-//                [--no-tracking] [--no-second-look] [--drop-unexplained]
+//                [--no-tracking] [--no-second-look] [--keep-unexplained]
 //                [--gravity-camera X Y Z] [--min-halo-excess GRAY]
 //
 // A first look at one's own footage: the real-water light detector, the identification and the
 // mono pose on every image, in name order (MonoLightPipeline: with a second look for the lights
 // that the first pass missed where the tracked or the new pose puts them, and over the whole image
 // at laxer thresholds when there is no pose; --no-second-look: the first pass only); the halo
-// colour threshold is learned from the identified lights (HaloColourLearner) unless given. With
-// --drop-unexplained, the detections that an image's pose leaves unidentified are reported as
-// rejected candidates ("not a light of the dock at the pose"), not as detections (on the pool
-// clip this also drops LEDs the matcher's gate left out: recall 1.000 -> 0.973). Writes,
+// colour threshold is learned from the identified lights (HaloColourLearner) unless given. The
+// detections that an image's pose leaves unidentified, far from every light it puts in the image
+// (MonoLightPipeline step 6), are reported as rejected candidates ("not a light of the dock at
+// the pose"), not as detections; --keep-unexplained keeps them. Writes,
 // flushed frame by frame (a stopped run keeps every frame written before the stop):
 //   OUTDIR/detections.csv  frame,image,light_id,u,v,radius,score,cov_uu,cov_uv,cov_vv,at_border
 //                          (light_id -1: not identified; covariance in px^2)
@@ -68,7 +68,7 @@ struct DetectOptions {
   bool deinterlace = false;
   bool no_tracking = false;
   bool no_second_look = false;
-  bool drop_unexplained = false;
+  bool keep_unexplained = false;
   bool quiet = false;
   std::vector<double> gravity_camera;
   double min_halo_excess = -1.0;  // < 0: learned from the identified lights
@@ -129,7 +129,7 @@ void RunDetect(const DetectOptions& options) {
   }
   pipeline_options.guided_search = !options.no_second_look;
   pipeline_options.weak_pass = !options.no_second_look;
-  pipeline_options.keep_unexplained = !options.drop_unexplained;
+  pipeline_options.keep_unexplained = options.keep_unexplained;
   MonoLightPoserOptions& poser_options = pipeline_options.poser;
   poser_options.use_tracking = !options.no_tracking;
   if (!options.gravity_camera.empty()) {
@@ -372,8 +372,9 @@ void AddDetectCommand(CLI::App& root) {
   sub->add_flag("--deinterlace", options->deinterlace,
                 "Interlaced video: detect on the even field, line-doubled");
   sub->add_flag("--no-tracking", options->no_tracking, "Identify every image from scratch");
-  sub->add_flag("--drop-unexplained", options->drop_unexplained,
-                "Report what an image's pose leaves unidentified as rejected, not as detections");
+  sub->add_flag("--keep-unexplained", options->keep_unexplained,
+                "Report as detections what an image's pose leaves unidentified far from every "
+                "light it predicts (by default: rejected, 'not a light of the dock at the pose')");
   sub->add_flag("--no-second-look", options->no_second_look,
                 "Only the full-image pass: no search where the pose puts the missed lights, no "
                 "laxer pass over an image without a pose");

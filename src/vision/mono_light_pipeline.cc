@@ -17,7 +17,9 @@ BlobLightDetectorOptions WeakOptions(const MonoLightPipelineOptions& options) {
   if (!(options.weak_min_response > 0.0) ||
       !(options.weak_halo_fraction >= 0.0 && options.weak_halo_fraction <= 1.0) ||
       !(options.weak_min_support >= 0.0 && options.weak_min_support <= 1.0) ||
-      !(options.tracking_motion_px > 0.0)) {
+      !(options.tracking_motion_px > 0.0) || !(options.unexplained_gate_sigmas >= 0.0) ||
+      !(options.unexplained_floor_px >= 0.0) ||
+      !(options.unexplained_min_support >= 0.0 && options.unexplained_min_support <= 1.0)) {
     throw std::invalid_argument("MonoLightPipelineOptions out of range");
   }
   BlobLightDetectorOptions weak = options.detector;
@@ -77,8 +79,8 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
   if (options_.guided_search && tracked &&
       frame.first_pass_detections < options_.poser.min_lights) {
     const double s2 = options_.tracking_motion_px * options_.tracking_motion_px;
-    std::vector<PredictedLight> predictions = PredictLights(
-        dock_, camera_.intrinsics, *tracked, Eigen::Matrix<double, 6, 6>::Zero(), {});
+    std::vector<PredictedLight> predictions =
+        PredictLights(dock_, camera_.intrinsics, *tracked, Eigen::Matrix<double, 6, 6>::Zero(), {});
     for (PredictedLight& p : predictions) p.covariance = s2 * Eigen::Matrix2d::Identity();
     for (const GuidedDetection& g :
          tracked_search_.Search(image, predictions, frame.detections, halo)) {
@@ -122,11 +124,12 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
       // A pose from weak blobs must explain most of the dock it puts in view (clutter can fit a
       // few lights of a layout, rarely most of them).
       const auto in_view = [&](const Pose3& T_C_D) {
-        return PredictLights(dock_, camera_.intrinsics, T_C_D, Eigen::Matrix<double, 6, 6>::Zero(), {})
+        return PredictLights(dock_, camera_.intrinsics, T_C_D, Eigen::Matrix<double, 6, 6>::Zero(),
+                             {})
             .size();
       };
-      if (retry.T_C_D &&
-          retry.num_lights >= options_.weak_min_support * static_cast<double>(in_view(*retry.T_C_D))) {
+      if (retry.T_C_D && retry.num_lights >= options_.weak_min_support *
+                                                 static_cast<double>(in_view(*retry.T_C_D))) {
         std::vector<LightDetection> kept;
         std::vector<int> ids;
         for (size_t i = 0; i < weak.size(); ++i) {
@@ -137,8 +140,8 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
         const size_t identified = kept.size();
         for (int i = 0; i < frame.first_pass_detections; ++i) {
           const LightDetection& d = frame.detections[i];
-          const bool same = std::any_of(
-              kept.begin(), kept.begin() + identified, [&](const LightDetection& k) {
+          const bool same =
+              std::any_of(kept.begin(), kept.begin() + identified, [&](const LightDetection& k) {
                 return (k.uv - d.uv).norm() <
                        std::max({options_.detector.min_separation_px, k.radius_px, d.radius_px});
               });
@@ -160,12 +163,31 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
         pose_search_, image, dock_, camera_.intrinsics, *frame.pose.T_C_D,
         frame.pose.covariance_local, 0.0, halo, &frame.detections, &frame.pose.light_ids);
   }
-  // 6. What the pose does not explain is not a light of the dock.
+  // 6. What the pose does not explain, far from every light it puts in the image, is not a light
+  // of the dock.
   if (frame.pose.T_C_D && !options_.keep_unexplained) {
-    for (size_t i = 0; i < frame.detections.size(); ++i) {
-      if (frame.pose.light_ids[i] < 0) frame.unexplained.push_back(frame.detections[i]);
-    }
-    KeepDetections(&frame, [](int, int id) { return id >= 0; });
+    const std::vector<PredictedLight> predicted = PredictLights(
+        dock_, camera_.intrinsics, *frame.pose.T_C_D, frame.pose.covariance_local, {});
+    const auto near_a_light = [&](const LightDetection& d) {
+      return std::any_of(predicted.begin(), predicted.end(), [&](const PredictedLight& p) {
+        const double sigma = std::sqrt(std::max(0.0, p.covariance.eigenvalues().real().maxCoeff()));
+        const double radius = options_.unexplained_gate_sigmas * sigma +
+                              std::max({options_.unexplained_floor_px, p.radius_px,
+                                        options_.unexplained_gate_sigmas * frame.pose.rms_px});
+        return (d.uv - p.uv).norm() <= radius;
+      });
+    };
+    // A pose that identifies few of the lights it puts in view (a poor camera model fits some
+    // lights and misplaces the rest) is no judge of the others.
+    const bool judge = frame.pose.num_lights >=
+                       options_.unexplained_min_support * static_cast<double>(predicted.size());
+    const std::vector<LightDetection> all = frame.detections;
+    if (judge)
+      KeepDetections(&frame, [&](int i, int id) {
+        if (id >= 0 || near_a_light(all[i])) return true;
+        frame.unexplained.push_back(all[i]);
+        return false;
+      });
   }
   frame.detect_s = Seconds(t0, t1) + Seconds(t2, Clock::now()) - frame.identify_s;
   frame.identify_s += Seconds(t1, t2);
