@@ -2,7 +2,9 @@
 # Accuracy, covariance consistency (NEES) and go/no-go safety of `auvdock run` (and `smooth`
 # with --smooth) over several seeds of a scenario, on the full image pipeline:
 #   bash scripts/evaluate_seeds.sh [--scenario FILE] [--seeds "1 2 3"] [--out DIR] [--smooth]
-#                                  [--detector contrast|blob]
+#                                  [--detector contrast|blob] [--reuse-datasets]
+# (--reuse-datasets: keep OUT/seed_N/dataset from an earlier call of the same scenario instead of
+# simulating again; AUVDOCK_BIN=path/to/auvdock runs another build.)
 # Needs a built tree (scripts/build.sh). Per seed it simulates, estimates and evaluates into
 # OUT/seed_N/, then prints one table: position RMSE and mean NEES by stage, GO count, unsafe GO
 # and the largest true lateral error at GO, and the means over the seeds.
@@ -13,6 +15,7 @@ seeds="1 2 3 4 5"
 out=out/seeds
 commands="run"
 detector=contrast
+reuse=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -20,16 +23,21 @@ while [[ $# -gt 0 ]]; do
     --out) out="$2"; shift 2 ;;
     --smooth) commands="run smooth"; shift ;;
     --detector) detector="$2"; shift 2 ;;
+    --reuse-datasets) reuse=1; shift ;;
     *) echo "evaluate_seeds.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
-bin=build/bin/auvdock
+bin=${AUVDOCK_BIN:-build/bin/auvdock}
 [[ -x "$bin" ]] || { echo "evaluate_seeds.sh: $bin not found: run scripts/build.sh" >&2; exit 2; }
 mkdir -p "$out"
 for seed in $seeds; do
   dir="$out/seed_$seed"
-  rm -rf "$dir"   # this script's own folder from an earlier call
-  "$bin" simulate --scenario "$scenario" --seed "$seed" --out "$dir/dataset" --quiet
+  if [[ $reuse == 1 && -f "$dir/dataset/groundtruth.tum" ]]; then
+    for command in run smooth; do rm -rf "${dir:?}/$command"; done
+  else
+    rm -rf "$dir"   # this script's own folder from an earlier call
+    "$bin" simulate --scenario "$scenario" --seed "$seed" --out "$dir/dataset" --quiet
+  fi
   for command in $commands; do
     "$bin" "$command" --dataset "$dir/dataset" --out "$dir/$command" --detector "$detector" \
       --quiet > /dev/null

@@ -160,6 +160,29 @@ std::vector<GuidedDetection> GuidedLightSearch::Search(
       candidate = {prediction.light_id, d, distance};
       best = &candidate;
     }
+    if (!best && options_.saturated_discs) {
+      // Too close and bright for a blob: the saturated disc there, if it holds this light only.
+      SaturatedDiscOptions disc_options;
+      disc_options.search_radius_px = gate;
+      const std::optional<LightDetection> disc = FindSaturatedDisc(image, prediction.uv, disc_options);
+      if (disc) {
+        const double distance = (disc->uv - prediction.uv).norm();
+        const double disc_sigma = std::sqrt(0.5 * disc->covariance.trace());
+        const bool alone = std::none_of(
+            predictions.begin(), predictions.end(), [&](const PredictedLight& other) {
+              return other.light_id != prediction.light_id &&
+                     (other.uv - disc->uv).norm() < disc->radius_px;
+            });
+        const bool seen =
+            std::any_of(existing.begin(), existing.end(), [&](const LightDetection& e) {
+              return (e.uv - disc->uv).norm() < std::max(e.radius_px, disc->radius_px);
+            });
+        if (alone && !seen && distance <= gate + 3.0 * disc_sigma) {
+          candidate = {prediction.light_id, *disc, distance};
+          best = &candidate;
+        }
+      }
+    }
     if (!best) continue;
     // One light per detection: a candidate another light's prediction already took goes to the
     // nearer prediction.

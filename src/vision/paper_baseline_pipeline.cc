@@ -243,10 +243,10 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
     colour_learners_[1].Observe(frame.right.detections, frame.right.light_ids);
     colour_learners_[2].Observe(frame.mono.detections, frame.mono.light_ids);
   }
+  const std::array<std::pair<const CameraCalibration*, const cv::Mat*>, 3> cameras = {
+      std::make_pair(left_, &left), std::make_pair(right_, &right), std::make_pair(mono_, &mono)};
+  std::array<CameraObservation*, 3> observations = {&frame.left, &frame.right, &frame.mono};
   if (options_.detector_kind == LightDetectorKind::kBlob && options_.guided_search && frame.T_D_B) {
-    const std::array<std::pair<const CameraCalibration*, const cv::Mat*>, 3> cameras = {
-        std::make_pair(left_, &left), std::make_pair(right_, &right), std::make_pair(mono_, &mono)};
-    std::array<CameraObservation*, 3> observations = {&frame.left, &frame.right, &frame.mono};
     for (int c = 0; c < 3; ++c) {
       const auto [camera, image] = cameras[c];
       if (!camera || image->empty()) continue;
@@ -258,6 +258,23 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
                                       colour_learners_[c].threshold(), &obs.detections,
                                       &obs.light_ids);
     }
+  }
+  // 7 (the search): where the estimate puts the lights of the cameras it identified.
+  if (frame.by_estimate && options_.detector_kind == LightDetectorKind::kBlob &&
+      options_.guided_search) {
+    for (int c = 0; c < 3; ++c) {
+      const auto [camera, image] = cameras[c];
+      CameraObservation& obs = *observations[c];
+      if (!camera || image->empty() || obs.status == MatchStatus::kOk) continue;
+      const int found = SearchMissedLights(
+          guided_search_, *image, dock_, camera->intrinsics,
+          (*predicted_T_D_B * camera->T_B_C).Inverse(), Eigen::Matrix<double, 6, 6>::Zero(),
+          options_.estimate_sigma_px, colour_learners_[c].threshold(), &obs.detections,
+          &obs.light_ids);
+      obs.guided += found;
+      obs.by_estimate += found;
+    }
+    NoteIdentified(frame);
   }
   return frame;
 }
@@ -312,7 +329,41 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
     last_T_D_B_ = frame.T_D_B;
     last_t_ns_ = t_ns;
   }
+  // 7. Without a pose: the few lights of each camera that identified none, by the estimate.
+  const bool estimate_is_fresh =
+      last_identified_t_ns_ && static_cast<double>(t_ns - *last_identified_t_ns_) * 1e-9 <=
+                                   options_.estimate_max_age_s;
+  if (options_.identify_by_estimate && !frame.T_D_B && predicted_T_D_B && estimate_is_fresh) {
+    frame.by_estimate = true;
+    const std::array<std::pair<const CameraCalibration*, CameraObservation*>, 3> cameras = {
+        std::make_pair(left_, &frame.left), std::make_pair(right_, &frame.right),
+        std::make_pair(mono_, &frame.mono)};
+    for (const auto& [camera, obs] : cameras) {
+      if (!camera || obs->status == MatchStatus::kOk || obs->detections.empty()) continue;
+      obs->light_ids = AssociateByPrediction(
+          obs->detections,
+          PredictLights(dock_, camera->intrinsics, (*predicted_T_D_B * camera->T_B_C).Inverse(),
+                        Eigen::Matrix<double, 6, 6>::Zero(), {}),
+          options_.estimate_association);
+      obs->by_estimate = obs->num_identified();
+      // A large blob's centre is less certain than its sharpness suggests (a saturated or
+      // merged glow): its covariance grows with its size.
+      for (size_t i = 0; i < obs->detections.size(); ++i) {
+        if (obs->light_ids[i] < 0) continue;
+        const double s = options_.estimate_size_sigma_fraction * obs->detections[i].radius_px;
+        obs->detections[i].covariance += s * s * Eigen::Matrix2d::Identity();
+      }
+    }
+  }
+  NoteIdentified(frame);
   return frame;
+}
+
+void PaperBaselinePipeline::NoteIdentified(const BaselineFrame& frame) {
+  if (frame.left.num_identified() + frame.right.num_identified() + frame.mono.num_identified() >
+      0) {
+    last_identified_t_ns_ = frame.t_ns;
+  }
 }
 
 }  // namespace auvdock

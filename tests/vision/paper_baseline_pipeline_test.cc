@@ -1,6 +1,7 @@
 #include "auvdock/vision/paper_baseline_pipeline.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <string>
 #include <optional>
@@ -186,6 +187,62 @@ TEST(PaperBaselinePipelineTest, MonoPoseOfAPlanarTwinIsChosenByThePrediction) {
   const Pose3 T_D_B = trajectory.At(27.5).T_D_B;
   EXPECT_LT((frame.T_D_B_mono->p - T_D_B.p).norm(), 0.05);
   EXPECT_LT(RotationAngleBetween(frame.T_D_B_mono->q, T_D_B.q), 0.02);
+}
+
+// The end of a landing: the mono camera sees two lights, too few for any pose. With a fresh
+// prediction from the estimator (a light was identified 0.1 s before) step 7 labels them; without
+// a prediction, or when the last identified light is older than estimate_max_age_s, it does not.
+TEST(PaperBaselinePipelineTest, TheEstimateIdentifiesTheFewLightsOfALanding) {
+  const Scenario scenario = test::DefaultScenario();
+  const Calibration calibration = MakeCalibration(scenario);
+  const DockingTrajectory trajectory(scenario.trajectory);
+  const auto two_lights = [&](const CameraCalibration& mono, const Pose3& T_D_B) {
+    std::vector<LightDetection> all = ProjectLights(mono, scenario.dock, T_D_B);
+    const std::vector<int> ids = TrueIds(all, mono, scenario.dock, T_D_B);
+    std::vector<LightDetection> two;
+    std::vector<int> two_ids;
+    for (size_t i = 0; i < all.size() && two.size() < 2; ++i) {
+      two.push_back(all[i]);
+      two_ids.push_back(ids[i]);
+    }
+    return std::make_pair(two, two_ids);
+  };
+  for (const double gap_s : {0.1, 0.7}) {
+    PaperBaselinePipeline pipeline(calibration, scenario.dock);
+    const CameraCalibration& mono = *pipeline.mono_camera();
+    const BaselineFrame seen = pipeline.ProcessDetections(
+        27'400'000'000, std::nullopt, std::nullopt,
+        ProjectLights(mono, scenario.dock, trajectory.At(27.4).T_D_B));
+    ASSERT_TRUE(seen.T_D_B.has_value()) << seen.reason;
+    const double t = 27.4 + gap_s;
+    const Pose3 T_D_B = trajectory.At(t).T_D_B;
+    const auto [detections, true_ids] = two_lights(mono, T_D_B);
+    ASSERT_EQ(detections.size(), 2u);
+    const int64_t t_ns = static_cast<int64_t>(std::llround(t * 1e9));
+    // A prediction 3 mm and 0.1 degrees off.
+    const Pose3 predicted(
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.0017, Eigen::Vector3d::UnitZ())) * T_D_B.q,
+        T_D_B.p + Eigen::Vector3d(0.003, -0.002, 0.001));
+    const BaselineFrame frame =
+        pipeline.ProcessDetections(t_ns, std::nullopt, std::nullopt, detections, predicted);
+    EXPECT_FALSE(frame.T_D_B.has_value());
+    if (gap_s < 0.5) {
+      EXPECT_TRUE(frame.by_estimate);
+      EXPECT_EQ(frame.mono.light_ids, true_ids);
+      EXPECT_EQ(frame.mono.by_estimate, 2);
+    } else {
+      EXPECT_FALSE(frame.by_estimate);
+      EXPECT_EQ(frame.mono.num_identified(), 0);
+    }
+  }
+  // No prediction: nothing to label by.
+  PaperBaselinePipeline pipeline(calibration, scenario.dock);
+  const CameraCalibration& mono = *pipeline.mono_camera();
+  pipeline.ProcessDetections(27'400'000'000, std::nullopt, std::nullopt,
+                             ProjectLights(mono, scenario.dock, trajectory.At(27.4).T_D_B));
+  const BaselineFrame frame = pipeline.ProcessDetections(
+      27'500'000'000, std::nullopt, std::nullopt, two_lights(mono, trajectory.At(27.5).T_D_B).first);
+  EXPECT_EQ(frame.mono.num_identified(), 0);
 }
 
 }  // namespace

@@ -23,6 +23,8 @@
 // larger of the two radii (min_separation_px at least) of it: that would be the same blob,
 // which the matcher already judged. At most one detection per light, and one light per
 // detection (two lights whose gates share a candidate: the nearer prediction keeps it).
+// A light so close that it is a saturated disc, with no peak at the searched scales, is taken
+// from the disc (saturated_discs; FindSaturatedDisc).
 //
 // Units: pixels (raw, distorted image; (0, 0) the centre of the top-left pixel), metres.
 #pragma once
@@ -37,6 +39,7 @@
 #include "auvdock/geometry/pose3.h"
 #include "auvdock/vision/blob_light_detector.h"
 #include "auvdock/vision/light_detection.h"
+#include "auvdock/vision/saturated_disc.h"
 
 namespace auvdock {
 
@@ -76,6 +79,10 @@ struct GuidedLightSearchOptions {
   double max_scale_ratio = 4.0;
   int num_scales = 6;
   double min_separation_px = 3.0;
+  // Where no blob qualifies, a saturated disc holding the prediction and no other light
+  // (saturated_disc.h: a light a few decimetres away), its centroid within the gate plus 3 of
+  // its sigmas.
+  bool saturated_discs = true;
 };
 
 struct GuidedDetection {

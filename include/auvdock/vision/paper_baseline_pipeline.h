@@ -46,6 +46,23 @@
 //      scaled by the identified lights' ObservedSizeRatio) and added
 //      with their identity (CameraObservation::guided); the frame's poses are not re-solved
 //      (the estimator fuses the added lights).
+//   7. identification by the estimate (identify_by_estimate): in a frame without a pose, each
+//      camera that identified no light labels its detections by the prediction from elsewhere
+//      (the estimator's IMU propagation, predicted_T_D_B) alone (AssociateByPrediction,
+//      prediction_association.h: a unique light within a few pixels; ProcessDetections does
+//      this) and, in Process with kBlob and guided_search, searches where the prediction puts
+//      its lights
+//      (estimate_sigma_px; scales up to 4x the expected size, for the large glows of a light
+//      under the camera). Only while the prediction is fresh: some camera identified lights
+//      within estimate_max_age_s before (so the estimator has been corrected by vision since).
+//      This is what keeps the vision in the last seconds of a landing, when each camera sees
+//      one or two lights and no per-frame pose exists; wrong labels meet the estimator's
+//      chi-square gate. Unverified by any pattern, these labels carry a centroid covariance that
+//      grows with the blob (+ (estimate_size_sigma_fraction r)^2): the centre of a light that
+//      fills a large part of the image, saturated or merged with its neighbours' glow, is not
+//      known to a fraction of a pixel (on our randomised renders a saturated disc's centroid is
+//      off by 0.1 of its radius up to 30 px, 0.2-0.3 beyond). The observations say how many of
+//      their labels came from here (CameraObservation::by_estimate).
 // Frames: D dock (z down), B body, C camera (OpenCV). Units: metres, radians, pixels.
 #pragma once
 
@@ -65,6 +82,7 @@
 #include "auvdock/vision/guided_light_search.h"
 #include "auvdock/vision/halo_colour_learner.h"
 #include "auvdock/vision/light_detector.h"
+#include "auvdock/vision/prediction_association.h"
 #include "auvdock/vision/ransac_matcher.h"
 #include "auvdock/vision/stereo_triangulation.h"
 #include "auvdock/vision/tracking_matcher.h"
@@ -97,6 +115,12 @@ struct PaperBaselineOptions {
   bool guided_search = true;          // step 6 (kBlob only)
   GuidedLightSearchOptions guided;
   double guided_pose_sigma_px = 1.5;  // the fused per-frame pose's error at a light, 1 sigma
+  bool identify_by_estimate = true;   // step 7
+  PredictionAssociationOptions estimate_association;
+  double estimate_sigma_px = 2.0;     // the estimate's error at a light, 1 sigma (step 7's search)
+  double estimate_max_age_s = 0.5;    // step 7 only within this of the last identified light
+  // Step 7's labels: each detection's centroid covariance grows by (this x its radius)^2.
+  double estimate_size_sigma_fraction = 0.1;
   uint64_t seed = 1;          // the matcher's random subsets (deterministic)
 };
 
@@ -108,7 +132,8 @@ struct CameraObservation {
   std::string reason;
   std::string symmetry;  // how a symmetric dock's pose was chosen (empty: not symmetric)
   bool tracked = false;  // identified by prediction (tracking) rather than from scratch
-  int guided = 0;        // detections added by the second look (step 6), at the end
+  int guided = 0;        // detections added by the second look (steps 6, 7), at the end
+  int by_estimate = 0;   // lights identified by the estimate alone (step 7)
   int num_identified() const;
 };
 
@@ -123,6 +148,7 @@ struct BaselineFrame {
   std::optional<Pose3> T_D_B;  // the fused (reported) pose
   double stereo_weight = 0.0;
   std::string reason;  // why there is no pose
+  bool by_estimate = false;  // step 7 ran: cameras that identified nothing used the estimate
 };
 
 class PaperBaselinePipeline {
@@ -165,6 +191,8 @@ class PaperBaselinePipeline {
   // T_C_D of `camera` predicted from the previous reported pose, if tracking is on and that pose
   // is at most tracking_max_age_s old.
   std::optional<Pose3> Predict(const CameraCalibration& camera, int64_t t_ns) const;
+  // Remembers the frame's time if any camera identified a light in it (step 7's freshness).
+  void NoteIdentified(const BaselineFrame& frame);
 
   Calibration calibration_;
   DockModel dock_;
@@ -177,6 +205,7 @@ class PaperBaselinePipeline {
   std::optional<Pose3> last_T_D_B_;  // the previous reported pose, for tracking
   std::optional<Pose3> external_T_D_B_;  // this frame's prediction from elsewhere, if any
   int64_t last_t_ns_ = 0;
+  std::optional<int64_t> last_identified_t_ns_;  // the last frame with an identified light
   const CameraCalibration* left_ = nullptr;
   const CameraCalibration* right_ = nullptr;
   const CameraCalibration* mono_ = nullptr;
