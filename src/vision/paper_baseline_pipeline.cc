@@ -20,14 +20,16 @@ BlobLightDetectorOptions WithDockColour(BlobLightDetectorOptions options, const 
 }  // namespace
 
 int CameraObservation::num_identified() const {
-  return static_cast<int>(std::count_if(light_ids.begin(), light_ids.end(),
-                                        [](int id) { return id >= 0; }));
+  return static_cast<int>(
+      std::count_if(light_ids.begin(), light_ids.end(), [](int id) { return id >= 0; }));
 }
 
-PaperBaselinePipeline::PaperBaselinePipeline(const Calibration& calibration,
-                                             const DockModel& dock,
+PaperBaselinePipeline::PaperBaselinePipeline(const Calibration& calibration, const DockModel& dock,
                                              const PaperBaselineOptions& options)
-    : calibration_(calibration), dock_(dock), options_(options), detector_(options.detector),
+    : calibration_(calibration),
+      dock_(dock),
+      options_(options),
+      detector_(options.detector),
       blob_detector_(WithDockColour(options.blob_detector, dock)),
       guided_search_(WithDockColour(options.blob_detector, dock), options.guided),
       colour_learners_{HaloColourLearner(options.blob_detector.checks.min_halo_excess),
@@ -51,16 +53,16 @@ PaperBaselinePipeline::PaperBaselinePipeline(const Calibration& calibration,
 
 std::optional<Pose3> PaperBaselinePipeline::Predict(const CameraCalibration& camera,
                                                     int64_t t_ns) const {
-  const bool recent = last_T_D_B_ && static_cast<double>(t_ns - last_t_ns_) * 1e-9 <=
-                                         options_.tracking_max_age_s;
+  const bool recent =
+      last_T_D_B_ && static_cast<double>(t_ns - last_t_ns_) * 1e-9 <= options_.tracking_max_age_s;
   if (!options_.use_tracking) return std::nullopt;
   if (recent) return (*last_T_D_B_ * camera.T_B_C).Inverse();
   if (external_T_D_B_) return (*external_T_D_B_ * camera.T_B_C).Inverse();
   return std::nullopt;
 }
 
-std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& camera,
-                                                     int64_t t_ns, CameraObservation* obs) {
+std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& camera, int64_t t_ns,
+                                                     CameraObservation* obs) {
   obs->light_ids.assign(obs->detections.size(), -1);
   MatchResult match;
   std::optional<Pose3> T_C_D;
@@ -143,8 +145,8 @@ void PaperBaselinePipeline::StereoPose(bool left_identified,
       }
     }
   } else {
-    pairs = MatchStereoDetections(frame->left.detections, frame->right.detections, *left_,
-                                  *right_, options_.stereo);
+    pairs = MatchStereoDetections(frame->left.detections, frame->right.detections, *left_, *right_,
+                                  options_.stereo);
   }
   std::vector<std::pair<int, int>> used;
   std::vector<Eigen::Vector3d> p_S, p_D;
@@ -206,8 +208,8 @@ void PaperBaselinePipeline::MonoPose(const std::optional<Pose3>& predicted_T_C_D
     points.push_back(dock_.FindLight(id)->p_D);
     pixels.push_back(frame->mono.detections[i].uv);
   }
-  const int needed = frame->mono.tracked ? std::min(3, options_.min_mono_lights)
-                                         : options_.min_mono_lights;
+  const int needed =
+      frame->mono.tracked ? std::min(3, options_.min_mono_lights) : options_.min_mono_lights;
   if (static_cast<int>(points.size()) < needed) return;
   PnpOptions pnp;
   pnp.pixel_sigma = mono_->pixel_noise_px;
@@ -251,12 +253,11 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
       const auto [camera, image] = cameras[c];
       if (!camera || image->empty()) continue;
       CameraObservation& obs = *observations[c];
-      obs.guided = SearchMissedLights(guided_search_, *image, dock_, camera->intrinsics,
-                                      (*frame.T_D_B * camera->T_B_C).Inverse(),
-                                      Eigen::Matrix<double, 6, 6>::Zero(),
-                                      options_.guided_pose_sigma_px,
-                                      colour_learners_[c].threshold(), &obs.detections,
-                                      &obs.light_ids);
+      obs.guided =
+          SearchMissedLights(guided_search_, *image, dock_, camera->intrinsics,
+                             (*frame.T_D_B * camera->T_B_C).Inverse(),
+                             Eigen::Matrix<double, 6, 6>::Zero(), options_.guided_pose_sigma_px,
+                             colour_learners_[c].threshold(), &obs.detections, &obs.light_ids);
     }
   }
   // 7 (the search): where the estimate puts the lights of the cameras it identified.
@@ -266,13 +267,14 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
       const auto [camera, image] = cameras[c];
       CameraObservation& obs = *observations[c];
       if (!camera || image->empty() || obs.status == MatchStatus::kOk) continue;
-      const int found = SearchMissedLights(
-          guided_search_, *image, dock_, camera->intrinsics,
-          (*predicted_T_D_B * camera->T_B_C).Inverse(), Eigen::Matrix<double, 6, 6>::Zero(),
-          options_.estimate_sigma_px, colour_learners_[c].threshold(), &obs.detections,
-          &obs.light_ids);
+      const Pose3 T_C_D = (*predicted_T_D_B * camera->T_B_C).Inverse();
+      const size_t first = obs.detections.size();
+      const int found =
+          SearchMissedLights(guided_search_, *image, dock_, camera->intrinsics, T_C_D,
+                             Eigen::Matrix<double, 6, 6>::Zero(), options_.estimate_sigma_px,
+                             colour_learners_[c].threshold(), &obs.detections, &obs.light_ids);
       obs.guided += found;
-      obs.by_estimate += found;
+      obs.by_estimate += WeighEstimateLabels(*camera, T_C_D, first, &obs);
     }
     NoteIdentified(frame);
   }
@@ -311,8 +313,8 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
   const bool mono_ok = frame.T_D_B_mono.has_value();
   if (stereo && mono_ok) {
     frame.stage = VisibilityStage::kBoth;
-    frame.stereo_weight = static_cast<double>(frame.n_stereo_lights) /
-                          (frame.n_stereo_lights + frame.n_mono_lights);
+    frame.stereo_weight =
+        static_cast<double>(frame.n_stereo_lights) / (frame.n_stereo_lights + frame.n_mono_lights);
     frame.T_D_B = Interpolate(*frame.T_D_B_mono, *frame.T_D_B_stereo, frame.stereo_weight);
   } else if (stereo) {
     frame.stage = VisibilityStage::kStereoOnly;
@@ -331,8 +333,8 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
   }
   // 7. Without a pose: the few lights of each camera that identified none, by the estimate.
   const bool estimate_is_fresh =
-      last_identified_t_ns_ && static_cast<double>(t_ns - *last_identified_t_ns_) * 1e-9 <=
-                                   options_.estimate_max_age_s;
+      last_identified_t_ns_ &&
+      static_cast<double>(t_ns - *last_identified_t_ns_) * 1e-9 <= options_.estimate_max_age_s;
   if (options_.identify_by_estimate && !frame.T_D_B && predicted_T_D_B && estimate_is_fresh) {
     frame.by_estimate = true;
     const std::array<std::pair<const CameraCalibration*, CameraObservation*>, 3> cameras = {
@@ -345,18 +347,37 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
           PredictLights(dock_, camera->intrinsics, (*predicted_T_D_B * camera->T_B_C).Inverse(),
                         Eigen::Matrix<double, 6, 6>::Zero(), {}),
           options_.estimate_association);
-      obs->by_estimate = obs->num_identified();
-      // A large blob's centre is less certain than its sharpness suggests (a saturated or
-      // merged glow): its covariance grows with its size.
-      for (size_t i = 0; i < obs->detections.size(); ++i) {
-        if (obs->light_ids[i] < 0) continue;
-        const double s = options_.estimate_size_sigma_fraction * obs->detections[i].radius_px;
-        obs->detections[i].covariance += s * s * Eigen::Matrix2d::Identity();
-      }
+      obs->by_estimate =
+          WeighEstimateLabels(*camera, (*predicted_T_D_B * camera->T_B_C).Inverse(), 0, obs);
     }
   }
   NoteIdentified(frame);
   return frame;
+}
+
+int PaperBaselinePipeline::WeighEstimateLabels(const CameraCalibration& camera, const Pose3& T_C_D,
+                                               size_t first, CameraObservation* obs) const {
+  const std::vector<PredictedLight> predicted =
+      PredictLights(dock_, camera.intrinsics, T_C_D, Eigen::Matrix<double, 6, 6>::Zero(), {});
+  int kept = 0;
+  for (size_t i = first; i < obs->detections.size(); ++i) {
+    const int id = obs->light_ids[i];
+    if (id < 0) continue;
+    LightDetection& d = obs->detections[i];
+    const double isolation = options_.estimate_association.isolation_radii * d.radius_px;
+    const bool merged =
+        std::any_of(predicted.begin(), predicted.end(), [&](const PredictedLight& p) {
+          return p.light_id != id && (p.uv - d.uv).norm() < isolation;
+        });
+    if (merged) {
+      obs->light_ids[i] = -1;
+      continue;
+    }
+    const double s = options_.estimate_size_sigma_fraction * d.radius_px;
+    d.covariance += s * s * Eigen::Matrix2d::Identity();
+    ++kept;
+  }
+  return kept;
 }
 
 void PaperBaselinePipeline::NoteIdentified(const BaselineFrame& frame) {

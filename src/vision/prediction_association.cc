@@ -24,7 +24,10 @@ std::vector<int> AssociateByPrediction(const std::vector<LightDetection>& detect
         d_second = d;
       }
     }
-    if (nearest < 0 || d_nearest > gate || d_second <= d_nearest + gate) continue;
+    if (nearest < 0 || d_nearest > gate || d_second <= d_nearest + gate ||
+        d_second < options.isolation_radii * detections[j].radius_px) {
+      continue;
+    }
     bool unique = true;
     for (size_t k = 0; k < detections.size() && unique; ++k) {
       if (k == j) continue;

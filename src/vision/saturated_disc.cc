@@ -27,7 +27,8 @@ cv::Mat SaturatedMask(const cv::Mat& image, int level) {
 
 }  // namespace
 
-std::optional<LightDetection> FindSaturatedDisc(const cv::Mat& image, const Eigen::Vector2d& seed_uv,
+std::optional<LightDetection> FindSaturatedDisc(const cv::Mat& image,
+                                                const Eigen::Vector2d& seed_uv,
                                                 const SaturatedDiscOptions& options) {
   if (image.empty() || (image.type() != CV_8UC3 && image.type() != CV_8UC1)) return std::nullopt;
   const int half = static_cast<int>(std::ceil(options.window_radius_px));

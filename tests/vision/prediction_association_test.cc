@@ -39,6 +39,13 @@ TEST(PredictionAssociationTest, AGateGrowsWithTheBlobsOwnSize) {
   EXPECT_EQ(AssociateByPrediction({At(338, 265, 20.0)}, lights)[0], -1);
 }
 
+// A glow that reaches another light's place (merged glows) has its centre pulled towards it.
+TEST(PredictionAssociationTest, ABlobThatCoversAnotherLightIsNotLabelled) {
+  const std::vector<PredictedLight> lights = {Light(4, 320, 256), Light(3, 361, 256)};
+  EXPECT_EQ(AssociateByPrediction({At(321, 256, 30.0)}, lights)[0], -1);  // light 3 at 1.4 r
+  EXPECT_EQ(AssociateByPrediction({At(321, 256, 15.0)}, lights)[0], 4);   // at 2.7 r
+}
+
 TEST(PredictionAssociationTest, NeverGuessesBetweenTwoCandidates) {
   // Two lights nearly equally near one detection.
   const std::vector<PredictedLight> close = {Light(1, 100, 100), Light(2, 106, 100)};

@@ -191,6 +191,11 @@ class PaperBaselinePipeline {
   // T_C_D of `camera` predicted from the previous reported pose, if tracking is on and that pose
   // is at most tracking_max_age_s old.
   std::optional<Pose3> Predict(const CameraCalibration& camera, int64_t t_ns) const;
+  // Step 7's labels from detection `first` on: withdrawn where another predicted light lies
+  // within isolation_radii blob radii (merged glows), else their covariance grown with the
+  // blob's size; returns how many stay.
+  int WeighEstimateLabels(const CameraCalibration& camera, const Pose3& T_C_D, size_t first,
+                          CameraObservation* obs) const;
   // Remembers the frame's time if any camera identified a light in it (step 7's freshness).
   void NoteIdentified(const BaselineFrame& frame);
 

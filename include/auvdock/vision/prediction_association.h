@@ -11,7 +11,10 @@
 // labelled L when
 //   d_jL <= g_j,                                  (the prediction explains it)
 //   d_jM > d_jL + g_j for every other light M,    (no other light could be it)
-//   d_kL > d_jL + g_j for every other detection k (no other detection could be L).
+//   d_kL > d_jL + g_j for every other detection k (no other detection could be L),
+//   d_jM >= isolation_radii * r_j for every other light M (no other light inside or at the rim
+//                                  of the blob: a glow that merges with a neighbour's has its
+//                                  centroid pulled towards it).
 // Otherwise it stays unlabelled: the rule never guesses between two candidates. Wrong labels
 // that slip through meet the estimator's chi-square gate on the residual.
 //
@@ -28,6 +31,7 @@ namespace auvdock {
 struct PredictionAssociationOptions {
   double gate_px = 4.0;
   double radius_fraction = 0.5;
+  double isolation_radii = 2.0;
 };
 
 // Per detection: the light id it is labelled with, or -1.

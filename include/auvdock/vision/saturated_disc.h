@@ -42,7 +42,8 @@ struct SaturatedDiscOptions {
 };
 
 // image: CV_8UC3 or CV_8UC1. Nothing when no region qualifies.
-std::optional<LightDetection> FindSaturatedDisc(const cv::Mat& image, const Eigen::Vector2d& seed_uv,
+std::optional<LightDetection> FindSaturatedDisc(const cv::Mat& image,
+                                                const Eigen::Vector2d& seed_uv,
                                                 const SaturatedDiscOptions& options = {});
 
 }  // namespace auvdock
