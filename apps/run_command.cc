@@ -51,6 +51,7 @@ void Run(const RunOptions& options) {
   const CancellationToken cancel = InstallSignalCancellation();
   RunCounters counters;
   size_t next_imu = 0;
+  size_t next_depth = 0;
   // The pipeline's prediction at a frame: the estimate propagated with the IMU up to the frame
   // (causal: samples at or before the frame time).
   const VisionFrameSource::Predictor predict = [&](int64_t t_ns) {
@@ -65,6 +66,10 @@ void Run(const RunOptions& options) {
       const auto t0 = Clock::now();
       while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= frame->last_t_ns()) {
         estimator.AddImu(dataset.imu[next_imu++]);
+      }
+      while (next_depth < dataset.depth.size() &&
+             dataset.depth[next_depth].t_ns <= frame->last_t_ns()) {
+        estimator.AddDepth(dataset.depth[next_depth++]);
       }
       const std::optional<EstimatorOutput> out = estimator.AddVisionFrame(*frame);
       counters.backend_s += Seconds(Clock::now() - t0);

@@ -24,6 +24,9 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                         {"observations", stats.skipped_observations}};
   summary["vision_residuals"] = {{"used", stats.used_observations},
                                  {"gated", stats.gated_observations}};
+  summary["depth_samples"] = {{"used", stats.depth_used},
+                              {"gated", stats.depth_gated},
+                              {"skipped", stats.depth_skipped}};
   summary["no_vision_reasons"] = source.no_vision_reasons();
   summary["warnings"] = source.warnings();
   summary["adaptive_variance_factor"] = {{"mono", stats.mono_variance_factor},

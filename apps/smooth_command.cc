@@ -49,6 +49,7 @@ void Smooth(const SmoothOptions& options) {
   RunCounters counters;
   std::vector<VisionFrame> frames;
   size_t next_imu = 0;
+  size_t next_depth = 0;
   // The pipeline's prediction at a frame: the estimate propagated with the IMU up to the frame
   // (causal: samples at or before the frame time).
   const VisionFrameSource::Predictor predict = [&](int64_t t_ns) {
@@ -62,6 +63,10 @@ void Smooth(const SmoothOptions& options) {
     const auto t0 = Clock::now();
     while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= frame->last_t_ns()) {
       estimator.AddImu(dataset.imu[next_imu++]);
+    }
+    while (next_depth < dataset.depth.size() &&
+           dataset.depth[next_depth].t_ns <= frame->last_t_ns()) {
+      estimator.AddDepth(dataset.depth[next_depth++]);
     }
     estimator.AddVisionFrame(*frame);
     counters.backend_s += Seconds(Clock::now() - t0);
@@ -82,7 +87,8 @@ void Smooth(const SmoothOptions& options) {
   }
   const auto t0 = Clock::now();
   const BatchResult result = SmoothBatch(dataset.calibration, *dataset.dock, frames, dataset.imu,
-                                         estimator.History(), config.estimator, batch);
+                                         estimator.History(), config.estimator, batch,
+                                         dataset.depth);
   counters.backend_s += Seconds(Clock::now() - t0);
   if (!options.quiet) std::fprintf(stderr, "\n");
 
@@ -104,6 +110,9 @@ void Smooth(const SmoothOptions& options) {
   stats.used_observations = result.stats.used_observations;
   stats.gated_observations = result.stats.gated_observations;
   stats.covariance_failures = result.stats.covariance_failures;
+  stats.depth_used = result.stats.depth_used;
+  stats.depth_gated = result.stats.depth_gated;
+  stats.depth_skipped = result.stats.depth_skipped;
   nlohmann::json summary = MakeRunSummary(source, stats, skipped_rows, counters);
   summary["batch"] = {{"segments", result.segments},
                       {"iterations", result.iterations},

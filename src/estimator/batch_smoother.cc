@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
 #include <ceres/covariance.h>
@@ -11,6 +13,7 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include "auvdock/estimator/depth_factors.h"
 #include "auvdock/estimator/imu_buffer.h"
 #include "auvdock/estimator/vision_factors.h"
 #include "factors/bias_prior_factor.h"
@@ -85,7 +88,8 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
                         const std::vector<ImuSample>& imu,
                         const std::vector<StateRecord>& warm_start,
                         const EstimatorOptions& estimator_options,
-                        const BatchSmootherOptions& options) {
+                        const BatchSmootherOptions& options,
+                        const std::vector<DepthMeasurement>& depth) {
   if (!calibration.imu) throw std::invalid_argument("SmoothBatch: the calibration has no IMU");
   BatchResult result;
   ImuBuffer buffer(*calibration.imu, estimator_options.max_imu_gap_s);
@@ -155,6 +159,29 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     }
   }
   if (states.empty()) return result;
+  // Depth samples on the states at or before them.
+  std::vector<ceres::ResidualBlockId> depth_residuals;
+  if (estimator_options.use_depth && calibration.depth) {
+    for (const DepthMeasurement& sample : depth) {
+      const auto after = std::upper_bound(
+          states.begin(), states.end(), sample.t_ns,
+          [](int64_t t, const std::unique_ptr<BatchState>& s) { return t < s->t_ns; });
+      std::optional<ceres::ResidualBlockId> id;
+      if (after != states.begin()) {
+        BatchState* s = std::prev(after)->get();
+        ImuBias bias;
+        bias.gyro = Eigen::Map<const Eigen::Vector3d>(s->bias);
+        bias.accel = Eigen::Map<const Eigen::Vector3d>(s->bias + 3);
+        id = AddDepthFactor(&problem, sample, *calibration.depth, dock,
+                            VisionState(s->pose, s->velocity, &buffer, bias), s->t_ns);
+      }
+      if (id) {
+        depth_residuals.push_back(*id);
+      } else {
+        ++result.stats.depth_skipped;
+      }
+    }
+  }
 
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
@@ -173,7 +200,10 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
                                      estimator_options.stereo_gate_chi2, &s->vision);
     gated += s->n_gated;
   }
-  if (gated > 0) ceres::Solve(solver, &problem, &summary);
+  result.stats.depth_gated =
+      GateDepthResiduals(&problem, estimator_options.depth_gate_chi2, &depth_residuals);
+  result.stats.depth_used = static_cast<int>(depth_residuals.size());
+  if (gated > 0 || result.stats.depth_gated > 0) ceres::Solve(solver, &problem, &summary);
   result.final_cost = summary.final_cost;
   result.iterations = static_cast<int>(summary.iterations.size());
   result.converged = summary.termination_type == ceres::CONVERGENCE;

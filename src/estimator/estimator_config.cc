@@ -19,6 +19,8 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.stereo_gate_chi2 = est.GetNonNegative("stereo_gate_chi2", e.stereo_gate_chi2);
   e.max_imu_gap_s = est.GetPositive("max_imu_gap_s", e.max_imu_gap_s);
   e.vision.use_mono = est.GetBool("use_mono", e.vision.use_mono);
+  e.use_depth = est.GetBool("use_depth", e.use_depth);
+  e.depth_gate_chi2 = est.GetNonNegative("depth_gate_chi2", e.depth_gate_chi2);
   e.vision.use_stereo = est.GetBool("use_stereo", e.vision.use_stereo);
   e.adaptive_vision_noise.enabled =
       est.GetBool("adaptive_vision_noise", e.adaptive_vision_noise.enabled);

@@ -8,6 +8,7 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include "auvdock/estimator/depth_factors.h"
 #include "auvdock/estimator/marginal_covariance.h"
 #include "auvdock/estimator/marginalization.h"
 #include "factors/bias_prior_factor.h"
@@ -192,6 +193,40 @@ bool SlidingWindowEstimator::Solve() {
   return true;
 }
 
+void SlidingWindowEstimator::AddDepth(const DepthMeasurement& sample) {
+  if (!options_.use_depth || !calibration_.depth) return;
+  if (!std::isfinite(sample.depth_m) ||
+      (!pending_depth_.empty() && sample.t_ns <= pending_depth_.back().t_ns)) {
+    ++stats_.depth_skipped;
+    return;
+  }
+  pending_depth_.push_back(sample);
+}
+
+std::vector<ceres::ResidualBlockId> SlidingWindowEstimator::AttachDepth(int64_t t_ns) {
+  std::vector<ceres::ResidualBlockId> added;
+  while (!pending_depth_.empty() && pending_depth_.front().t_ns <= t_ns) {
+    const DepthMeasurement sample = pending_depth_.front();
+    pending_depth_.pop_front();
+    // The latest state at or before the sample.
+    auto it = std::find_if(window_.rbegin(), window_.rend(),
+                           [&](const std::unique_ptr<State>& s) { return s->t_ns <= sample.t_ns; });
+    std::optional<ceres::ResidualBlockId> id;
+    if (it != window_.rend()) {
+      State& state = **it;
+      id = AddDepthFactor(problem_.get(), sample, *calibration_.depth, dock_,
+                          VisionState(state.pose, state.velocity, &imu_, LoadBias(state.bias)),
+                          state.t_ns);
+    }
+    if (id) {
+      added.push_back(*id);
+    } else {
+      ++stats_.depth_skipped;
+    }
+  }
+  return added;
+}
+
 void SlidingWindowEstimator::MarginalizeOldest() {
   State& oldest = *window_.front();
   StateRecord record;
@@ -266,6 +301,7 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
                                    VisionState(state->pose, state->velocity, &imu_,
                                                LoadBias(state->bias)),
                                    &stats_.skipped_observations);
+  std::vector<ceres::ResidualBlockId> depth = AttachDepth(frame.t_ns);
 
   if (!Solve()) {
     ++stats_.solver_failures;
@@ -274,7 +310,10 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   }
   state->n_gated = GateVisionResiduals(problem_.get(), options_.mono_gate_chi2,
                                        options_.stereo_gate_chi2, &state->vision);
-  if (state->n_gated > 0 && !Solve()) {
+  const int depth_gated = GateDepthResiduals(problem_.get(), options_.depth_gate_chi2, &depth);
+  stats_.depth_gated += depth_gated;
+  stats_.depth_used += static_cast<int>(depth.size());
+  if ((state->n_gated > 0 || depth_gated > 0) && !Solve()) {
     ++stats_.solver_failures;
     Reset("solver failed at " + std::to_string(frame.t_ns) + " ns (after gating)");
     return std::nullopt;

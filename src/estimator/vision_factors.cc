@@ -50,23 +50,6 @@ double Factor(const std::map<int, double>& factors, int light_id) {
   return it == factors.end() ? 1.0 : it->second;
 }
 
-// The IMU's motion from the state's time to an image dt_ns later; an identity shift for dt = 0,
-// nothing when the IMU does not cover the interval.
-std::optional<ImuPoseShift> ShiftTo(const VisionFrame& frame, int64_t dt_ns,
-                                    const VisionState& state, const Eigen::Vector3d& gravity_D) {
-  ImuPoseShift shift;
-  shift.gravity_D = gravity_D;
-  if (dt_ns <= 0) return shift;
-  if (state.imu == nullptr || state.velocity == nullptr) return std::nullopt;
-  const std::optional<ImuPreintegration> pim =
-      state.imu->Preintegrate(frame.t_ns, frame.t_ns + dt_ns, state.bias);
-  if (!pim) return std::nullopt;
-  shift.dt_s = pim->sum_dt();
-  shift.delta_q = pim->delta_q();
-  shift.delta_p = pim->delta_p();
-  return shift;
-}
-
 // Adds `factor` on the state's pose, or through the shift on its pose and velocity.
 template <typename Factor, int kResiduals>
 ceres::ResidualBlockId AddResidual(ceres::Problem* problem, std::unique_ptr<Factor> factor,
@@ -83,6 +66,21 @@ ceres::ResidualBlockId AddResidual(ceres::Problem* problem, std::unique_ptr<Fact
 }
 
 }  // namespace
+
+std::optional<ImuPoseShift> ImuShiftFromState(const VisionState& state, int64_t t_state_ns,
+                                              int64_t dt_ns, const Eigen::Vector3d& gravity_D) {
+  ImuPoseShift shift;
+  shift.gravity_D = gravity_D;
+  if (dt_ns <= 0) return shift;
+  if (state.imu == nullptr || state.velocity == nullptr) return std::nullopt;
+  const std::optional<ImuPreintegration> pim =
+      state.imu->Preintegrate(t_state_ns, t_state_ns + dt_ns, state.bias);
+  if (!pim) return std::nullopt;
+  shift.dt_s = pim->sum_dt();
+  shift.delta_q = pim->delta_q();
+  shift.delta_p = pim->delta_p();
+  return shift;
+}
 
 double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
                                 double frame_interval_s) {
@@ -106,9 +104,9 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
   int n_stereo = stereo ? static_cast<int>(frame.stereo.size()) : 0;
   // Each image's pose: the state's, moved by the IMU to the image's own time.
   const std::optional<ImuPoseShift> mono_shift =
-      ShiftTo(frame, frame.mono_dt_ns, state, rig.dock->gravity_D);
+      ImuShiftFromState(state, frame.t_ns, frame.mono_dt_ns, rig.dock->gravity_D);
   const std::optional<ImuPoseShift> stereo_shift =
-      ShiftTo(frame, frame.stereo_dt_ns, state, rig.dock->gravity_D);
+      ImuShiftFromState(state, frame.t_ns, frame.stereo_dt_ns, rig.dock->gravity_D);
   if (!mono_shift) *n_skipped += std::exchange(n_mono, 0);
   if (!stereo_shift) *n_skipped += std::exchange(n_stereo, 0);
   double mono_pose[kPoseSize], stereo_pose[kPoseSize];

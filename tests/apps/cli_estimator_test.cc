@@ -79,6 +79,8 @@ TEST_F(EstimatorCli, RunAndSmoothWriteEveryFileAndTheFilesEvaluate) {
       EXPECT_GE(summary.at("timing_s").at(key).get<double>(), 0.0) << command << " " << key;
     }
     EXPECT_EQ(summary.at("resets").get<int>(), 0) << command;
+    // 31 depth samples at 10 Hz; the first ones come before the first state.
+    EXPECT_GE(summary.at("depth_samples").at("used").get<int>(), 20) << command;
 
     const auto e = test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate",
                                      out + "/trajectory.tum", "--covariance",

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "auvdock/sim/depth_simulator.h"
 #include "auvdock/sim/docking_simulator.h"
 #include "auvdock/sim/imu_simulator.h"
 #include "auvdock/sim/random_stream.h"
@@ -50,6 +51,13 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
     const int64_t t = simulator.SampleTime(k, scenario.imu.rate_hz);
     if (simulator.Seconds(t) > scenario.duration_s) break;
     run.imu.push_back(imu.Sample(t, simulator.trajectory().At(simulator.Seconds(t))));
+  }
+
+  DepthSimulator depth(scenario.depth, scenario.dock, true, MakeRandomStream(seed, 104));
+  for (int64_t k = 0;; ++k) {
+    const int64_t t = simulator.SampleTime(k, scenario.depth.rate_hz);
+    if (simulator.Seconds(t) > scenario.duration_s) break;
+    run.depth.push_back(depth.Sample(t, simulator.trajectory().At(simulator.Seconds(t))));
   }
 
   std::mt19937_64 rng = MakeRandomStream(seed, 102);

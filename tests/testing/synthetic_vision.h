@@ -25,6 +25,7 @@ struct SyntheticRun {
   std::vector<ImuSample> imu;
   std::vector<VisionFrame> frames;
   std::vector<StampedPose> truth;  // body pose at each frame
+  std::vector<DepthMeasurement> depth;  // the scenario's depth sensor (sim/depth_simulator.h)
 };
 
 SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed, double pixel_sigma = 0.3);

@@ -19,6 +19,7 @@
 // the oldest state into the prior when the window is full (estimator/marginalization.h), and
 // report the newest pose's marginal covariance (estimator/marginal_covariance.h).
 // Without vision the window carries on on the IMU alone; the covariance grows accordingly.
+// Depth samples (AddDepth) join the state at or before their time (estimator/depth_factors.h).
 //
 // Initialisation: at the first frame with a per-frame pose (VisionFrame::T_D_B_initial): that
 // pose, zero velocity and zero biases, each with a prior (EstimatorOptions). The attitude then
@@ -104,6 +105,11 @@ struct EstimatorOptions {
   // dock"). 0 = white errors only.
   double window_vision_floor_px = 0.07;
   double window_vision_correlation_time_s = 1.0;
+  // Pressure depth (estimator/depth_factors.h; needs the calibration's depth sensor): each sample
+  // against the dock's origin_depth_m, at its own time; a whitened residual beyond the gate
+  // (chi-square, 1 dof, p = 0.999) after the solve is removed.
+  bool use_depth = true;
+  double depth_gate_chi2 = 10.83;
 };
 
 // The estimate at one state.
@@ -132,6 +138,9 @@ struct EstimatorStats {
   int resets = 0;
   int solver_failures = 0;
   int covariance_failures = 0;
+  int depth_used = 0;     // depth samples in the cost (after gating)
+  int depth_gated = 0;    // beyond the depth gate
+  int depth_skipped = 0;  // not finite, out of order, before the first state or beyond the IMU
   // The adaptive variance factors in use at the end, per light id.
   std::map<int, double> mono_variance_factor;
   std::map<int, double> stereo_variance_factor;
@@ -159,6 +168,11 @@ class SlidingWindowEstimator {
   // IMU samples in time order; a sample out of order, repeated or not finite is skipped.
   void AddImu(const ImuSample& sample);
 
+  // A depth sample, in time order; used with the first frame at or after its time (frames and
+  // samples must reach the estimator in time order: the caller feeds the samples up to the
+  // frame's last image before the frame).
+  void AddDepth(const DepthMeasurement& sample);
+
   // A camera frame (identified lights; possibly none). Returns the newest state's estimate, or
   // nothing before initialisation / after a reset until the next per-frame pose.
   std::optional<EstimatorOutput> AddVisionFrame(const VisionFrame& frame);
@@ -181,6 +195,9 @@ class SlidingWindowEstimator {
   bool AddState(int64_t t_ns);
   bool Solve();
   void MarginalizeOldest();
+  // The pending depth samples up to t_ns onto the states at or before them; returns the
+  // residuals added.
+  std::vector<ceres::ResidualBlockId> AttachDepth(int64_t t_ns);
   EstimatorOutput Output(const State& state);
   // The newest frame's vision residuals, with their leverage on the newest pose (its covariance
   // in the tangent space), into the adaptive noise factors of their lights.
@@ -195,6 +212,7 @@ class SlidingWindowEstimator {
   std::deque<std::unique_ptr<State>> window_;
   ImuBuffer imu_;
   std::vector<StateRecord> history_;
+  std::deque<DepthMeasurement> pending_depth_;
   int64_t last_frame_t_ns_ = INT64_MIN;
   int64_t last_vision_t_ns_ = INT64_MIN;
   EstimatorStats stats_;

@@ -34,11 +34,13 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <vector>
 
 #include <ceres/problem.h>
 
 #include "auvdock/estimator/imu_buffer.h"
+#include "factors/time_shifted_factor.h"
 #include "auvdock/estimator/stage_weighting.h"
 #include "auvdock/estimator/vision_frame.h"
 #include "auvdock/geometry/dock_model.h"
@@ -96,6 +98,12 @@ struct VisionState {
   const ImuBuffer* imu;
   ImuBias bias;
 };
+
+// The IMU's motion from the state's time t_state_ns to dt_ns later (factors/time_shifted_factor.h):
+// an identity shift for dt_ns <= 0, nothing when the state has no velocity block or IMU, or the
+// IMU does not cover the interval.
+std::optional<ImuPoseShift> ImuShiftFromState(const VisionState& state, int64_t t_state_ns,
+                                              int64_t dt_ns, const Eigen::Vector3d& gravity_D);
 
 // Adds the frame's residuals on the state's blocks (already in the problem). Observations with
 // an unknown light id or non-finite values, mono observations of a light behind the camera at

@@ -1,0 +1,53 @@
+#include "auvdock/estimator/depth_factors.h"
+
+#include <cmath>
+#include <memory>
+#include <utility>
+
+#include "factors/depth_factor.h"
+#include "factors/time_shifted_factor.h"
+
+namespace auvdock {
+
+std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
+                                                     const DepthMeasurement& sample,
+                                                     const DepthCalibration& calibration,
+                                                     const DockModel& dock,
+                                                     const VisionState& state, int64_t t_state_ns) {
+  if (!std::isfinite(sample.depth_m) || sample.t_ns < t_state_ns) return std::nullopt;
+  const std::optional<ImuPoseShift> shift =
+      ImuShiftFromState(state, t_state_ns, sample.t_ns - t_state_ns, dock.gravity_D);
+  if (!shift) return std::nullopt;
+  auto factor =
+      std::make_unique<DepthFactor>(sample.depth_m, calibration.sigma_m, dock.origin_depth_m,
+                                    dock.gravity_D, calibration.T_B_S.p);
+  if (shift->dt_s == 0.0) {
+    return problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<DepthFactor, kDepthResidualSize, kPoseSize>(
+            factor.release()),
+        nullptr, state.pose);
+  }
+  return problem->AddResidualBlock(
+      TimeShiftedFactor<DepthFactor, kDepthResidualSize>::Create(std::move(factor), *shift),
+      nullptr, state.pose, state.velocity);
+}
+
+int GateDepthResiduals(ceres::Problem* problem, double gate_chi2,
+                       std::vector<ceres::ResidualBlockId>* residuals) {
+  int gated = 0;
+  std::vector<ceres::ResidualBlockId> kept;
+  for (const ceres::ResidualBlockId id : *residuals) {
+    double cost = 0.0;
+    problem->EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, nullptr, nullptr);
+    if (gate_chi2 > 0.0 && 2.0 * cost > gate_chi2) {
+      problem->RemoveResidualBlock(id);
+      ++gated;
+    } else {
+      kept.push_back(id);
+    }
+  }
+  *residuals = std::move(kept);
+  return gated;
+}
+
+}  // namespace auvdock
