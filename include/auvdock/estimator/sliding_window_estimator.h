@@ -7,6 +7,7 @@
 // + sum_k |r_imu(x_k, x_k+1)|^2                      IMU preintegration between consecutive states
 // + sum_k sum_lights w_mono(k)   rho(|r_mono|^2)     mono reprojection of identified dock lights
 // + sum_k sum_lights w_stereo(k) rho(|r_stereo|^2)   triangulated lights against the dock model
+// + sum_depth |r_depth|^2                            pressure depth against the dock's depth
 // where every r is whitened by its own noise model (pixel noise, triangulation covariance,
 // preintegrated IMU covariance), rho is a Huber loss, and w are the stage weights
 // (estimator/stage_weighting.h: by default pure information weighting, w = 1). This is the
