@@ -14,6 +14,7 @@
 #include "apps/commands.h"
 #include "apps/estimate_writer.h"
 #include "apps/run_summary.h"
+#include "apps/sensor_feed.h"
 #include "apps/signal_flag.h"
 #include "apps/vision_frame_source.h"
 #include "auvdock/estimator/estimator_config.h"
@@ -50,27 +51,18 @@ void Run(const RunOptions& options) {
 
   const CancellationToken cancel = InstallSignalCancellation();
   RunCounters counters;
-  size_t next_imu = 0;
-  size_t next_depth = 0;
+  SensorFeed feed(dataset, &estimator);
   // The pipeline's prediction at a frame: the estimate propagated with the IMU up to the frame
   // (causal: samples at or before the frame time).
   const VisionFrameSource::Predictor predict = [&](int64_t t_ns) {
-    while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= t_ns) {
-      estimator.AddImu(dataset.imu[next_imu++]);
-    }
+    feed.FeedImuUpTo(t_ns);
     return estimator.PropagatedPose(t_ns);
   };
   size_t log_printed = 0;
   try {
     while (const std::optional<VisionFrame> frame = source.Next(predict)) {
       const auto t0 = Clock::now();
-      while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= frame->last_t_ns()) {
-        estimator.AddImu(dataset.imu[next_imu++]);
-      }
-      while (next_depth < dataset.depth.size() &&
-             dataset.depth[next_depth].t_ns <= frame->last_t_ns()) {
-        estimator.AddDepth(dataset.depth[next_depth++]);
-      }
+      feed.FeedAllUpTo(frame->last_t_ns());
       const std::optional<EstimatorOutput> out = estimator.AddVisionFrame(*frame);
       counters.backend_s += Seconds(Clock::now() - t0);
       ++counters.frames;

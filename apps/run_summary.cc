@@ -27,6 +27,10 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
   summary["depth_samples"] = {{"used", stats.depth_used},
                               {"gated", stats.depth_gated},
                               {"skipped", stats.depth_skipped}};
+  summary["dvl_samples"] = {{"used", stats.dvl_used},
+                            {"gated", stats.dvl_gated},
+                            {"no_bottom_lock", stats.dvl_no_lock},
+                            {"skipped", stats.dvl_skipped}};
   summary["no_vision_reasons"] = source.no_vision_reasons();
   summary["warnings"] = source.warnings();
   summary["adaptive_variance_factor"] = {{"mono", stats.mono_variance_factor},

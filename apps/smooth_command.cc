@@ -12,6 +12,7 @@
 #include "apps/commands.h"
 #include "apps/estimate_writer.h"
 #include "apps/run_summary.h"
+#include "apps/sensor_feed.h"
 #include "apps/signal_flag.h"
 #include "apps/vision_frame_source.h"
 #include "auvdock/estimator/batch_smoother.h"
@@ -48,26 +49,17 @@ void Smooth(const SmoothOptions& options) {
   const CancellationToken cancel = InstallSignalCancellation();
   RunCounters counters;
   std::vector<VisionFrame> frames;
-  size_t next_imu = 0;
-  size_t next_depth = 0;
+  SensorFeed feed(dataset, &estimator);
   // The pipeline's prediction at a frame: the estimate propagated with the IMU up to the frame
   // (causal: samples at or before the frame time).
   const VisionFrameSource::Predictor predict = [&](int64_t t_ns) {
-    while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= t_ns) {
-      estimator.AddImu(dataset.imu[next_imu++]);
-    }
+    feed.FeedImuUpTo(t_ns);
     return estimator.PropagatedPose(t_ns);
   };
   while (std::optional<VisionFrame> frame = source.Next(predict)) {
     cancel.ThrowIfCancelled();
     const auto t0 = Clock::now();
-    while (next_imu < dataset.imu.size() && dataset.imu[next_imu].t_ns <= frame->last_t_ns()) {
-      estimator.AddImu(dataset.imu[next_imu++]);
-    }
-    while (next_depth < dataset.depth.size() &&
-           dataset.depth[next_depth].t_ns <= frame->last_t_ns()) {
-      estimator.AddDepth(dataset.depth[next_depth++]);
-    }
+    feed.FeedAllUpTo(frame->last_t_ns());
     estimator.AddVisionFrame(*frame);
     counters.backend_s += Seconds(Clock::now() - t0);
     ++counters.frames;
@@ -88,7 +80,7 @@ void Smooth(const SmoothOptions& options) {
   const auto t0 = Clock::now();
   const BatchResult result = SmoothBatch(dataset.calibration, *dataset.dock, frames, dataset.imu,
                                          estimator.History(), config.estimator, batch,
-                                         dataset.depth);
+                                         NavigationSamples{dataset.depth, dataset.dvl});
   counters.backend_s += Seconds(Clock::now() - t0);
   if (!options.quiet) std::fprintf(stderr, "\n");
 
@@ -113,6 +105,10 @@ void Smooth(const SmoothOptions& options) {
   stats.depth_used = result.stats.depth_used;
   stats.depth_gated = result.stats.depth_gated;
   stats.depth_skipped = result.stats.depth_skipped;
+  stats.dvl_used = result.stats.dvl_used;
+  stats.dvl_gated = result.stats.dvl_gated;
+  stats.dvl_no_lock = result.stats.dvl_no_lock;
+  stats.dvl_skipped = result.stats.dvl_skipped;
   nlohmann::json summary = MakeRunSummary(source, stats, skipped_rows, counters);
   summary["batch"] = {{"segments", result.segments},
                       {"iterations", result.iterations},

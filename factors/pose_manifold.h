@@ -28,6 +28,7 @@
 #include <ceres/manifold.h>
 
 #include "auvdock/geometry/pose3.h"
+#include "auvdock/imu/imu_preintegration.h"
 
 namespace auvdock {
 
@@ -79,6 +80,14 @@ Eigen::Matrix<T, 3, 1> QuaternionLog(const Eigen::Quaternion<T>& q_in) {
 inline Pose3 PoseFromBlock(const double* pose) {
   return Pose3(Eigen::Map<const Eigen::Quaterniond>(pose + 3).normalized(),
                Eigen::Map<const Eigen::Vector3d>(pose));
+}
+
+// The biases a bias block holds (b_g, b_a).
+inline ImuBias BiasFromBlock(const double* bias) {
+  ImuBias b;
+  b.gyro = Eigen::Map<const Eigen::Vector3d>(bias);
+  b.accel = Eigen::Map<const Eigen::Vector3d>(bias + 3);
+  return b;
 }
 
 inline void PoseToBlock(const Pose3& T, double* pose) {

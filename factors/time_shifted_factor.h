@@ -40,6 +40,7 @@ struct ImuPoseShift {
   double dt_s = 0.0;
   Eigen::Quaterniond delta_q = Eigen::Quaterniond::Identity();  // R_Bk_Bt
   Eigen::Vector3d delta_p = Eigen::Vector3d::Zero();            // m, in B_k
+  Eigen::Vector3d delta_v = Eigen::Vector3d::Zero();            // m/s, in B_k
   Eigen::Vector3d gravity_D = Eigen::Vector3d::Zero();          // m/s^2, in D
 
   // The pose block at t_k + dt from the state's pose and velocity blocks.
@@ -55,6 +56,17 @@ struct ImuPoseShift {
     p_t = p_k + v * dt + gravity_D.cast<T>() * T(0.5 * dt_s * dt_s) + q_k * delta_p.cast<T>();
     q_t = q_k * delta_q.cast<T>();
   }
+
+  // The velocity at t_k + dt: v_D_t = v_D_k + g_D dt + R_D_Bk dv (for factors on the velocity,
+  // e.g. factors/dvl_factor.h).
+  template <typename T>
+  void ApplyVelocity(const T* pose_D_Bk, const T* v_D, T* v_D_t) const {
+    using Vector3T = Eigen::Matrix<T, 3, 1>;
+    const Eigen::Map<const Eigen::Quaternion<T>> q_k(pose_D_Bk + 3);
+    const Eigen::Map<const Vector3T> v(v_D);
+    Eigen::Map<Vector3T> v_t(v_D_t);
+    v_t = v + gravity_D.cast<T>() * T(dt_s) + q_k * delta_v.cast<T>();
+  }
 };
 
 template <typename Factor, int kResiduals>
@@ -66,7 +78,8 @@ class TimeShiftedFactor {
     if (!factor_) throw std::invalid_argument("TimeShiftedFactor: no factor");
     if (!(shift_.dt_s >= 0.0) || !std::isfinite(shift_.dt_s) ||
         !shift_.delta_q.coeffs().allFinite() || !(shift_.delta_q.norm() > 0.0) ||
-        !shift_.delta_p.allFinite() || !shift_.gravity_D.allFinite()) {
+        !shift_.delta_p.allFinite() || !shift_.delta_v.allFinite() ||
+        !shift_.gravity_D.allFinite()) {
       throw std::invalid_argument("TimeShiftedFactor: dt must be >= 0 and the shift finite");
     }
     shift_.delta_q.normalize();

@@ -13,7 +13,7 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
-#include "auvdock/estimator/depth_factors.h"
+#include "auvdock/estimator/sensor_factors.h"
 #include "auvdock/estimator/imu_buffer.h"
 #include "auvdock/estimator/vision_factors.h"
 #include "factors/bias_prior_factor.h"
@@ -89,7 +89,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
                         const std::vector<StateRecord>& warm_start,
                         const EstimatorOptions& estimator_options,
                         const BatchSmootherOptions& options,
-                        const std::vector<DepthMeasurement>& depth) {
+                        const NavigationSamples& sensors) {
   if (!calibration.imu) throw std::invalid_argument("SmoothBatch: the calibration has no IMU");
   BatchResult result;
   ImuBuffer buffer(*calibration.imu, estimator_options.max_imu_gap_s);
@@ -134,9 +134,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     bool joined = false;
     if (k > 0) {
       BatchState* p = states[k - 1].get();
-      ImuBias bias;
-      bias.gyro = Eigen::Map<const Eigen::Vector3d>(p->bias);
-      bias.accel = Eigen::Map<const Eigen::Vector3d>(p->bias + 3);
+      const ImuBias bias = BiasFromBlock(p->bias);
       const std::optional<ImuPreintegration> pim = buffer.Preintegrate(p->t_ns, s->t_ns, bias);
       if (pim) {
         problem.AddResidualBlock(ImuPreintegrationFactor::Create(*pim, dock.gravity_D), nullptr,
@@ -150,35 +148,52 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     }
     const auto f = frame_at.find(s->t_ns);
     if (f != frame_at.end()) {
-      ImuBias bias;
-      bias.gyro = Eigen::Map<const Eigen::Vector3d>(s->bias);
-      bias.accel = Eigen::Map<const Eigen::Vector3d>(s->bias + 3);
+      const ImuBias bias = BiasFromBlock(s->bias);
       s->vision = AddVisionFactors(&problem, *f->second, rig, vision_options,
                                    VisionState(s->pose, s->velocity, &buffer, bias),
                                    &result.stats.skipped_observations);
     }
   }
   if (states.empty()) return result;
-  // Depth samples on the states at or before them.
+  // Depth and DVL samples on the states at or before them.
+  const auto state_at_or_before = [&](int64_t t_ns) -> BatchState* {
+    const auto after = std::upper_bound(
+        states.begin(), states.end(), t_ns,
+        [](int64_t t, const std::unique_ptr<BatchState>& s) { return t < s->t_ns; });
+    return after == states.begin() ? nullptr : std::prev(after)->get();
+  };
+  const auto blocks_of = [&](BatchState* s) {
+    return VisionState(s->pose, s->velocity, &buffer, BiasFromBlock(s->bias));
+  };
   std::vector<ceres::ResidualBlockId> depth_residuals;
   if (estimator_options.use_depth && calibration.depth) {
-    for (const DepthMeasurement& sample : depth) {
-      const auto after = std::upper_bound(
-          states.begin(), states.end(), sample.t_ns,
-          [](int64_t t, const std::unique_ptr<BatchState>& s) { return t < s->t_ns; });
+    for (const DepthMeasurement& sample : sensors.depth) {
       std::optional<ceres::ResidualBlockId> id;
-      if (after != states.begin()) {
-        BatchState* s = std::prev(after)->get();
-        ImuBias bias;
-        bias.gyro = Eigen::Map<const Eigen::Vector3d>(s->bias);
-        bias.accel = Eigen::Map<const Eigen::Vector3d>(s->bias + 3);
-        id = AddDepthFactor(&problem, sample, *calibration.depth, dock,
-                            VisionState(s->pose, s->velocity, &buffer, bias), s->t_ns);
+      if (BatchState* s = state_at_or_before(sample.t_ns)) {
+        id = AddDepthFactor(&problem, sample, *calibration.depth, dock, blocks_of(s), s->t_ns);
       }
       if (id) {
         depth_residuals.push_back(*id);
       } else {
         ++result.stats.depth_skipped;
+      }
+    }
+  }
+  std::vector<ceres::ResidualBlockId> dvl_residuals;
+  if (estimator_options.use_dvl && calibration.dvl) {
+    for (const DvlMeasurement& sample : sensors.dvl) {
+      if (!sample.v_S.allFinite()) {
+        ++result.stats.dvl_no_lock;
+        continue;
+      }
+      std::optional<ceres::ResidualBlockId> id;
+      if (BatchState* s = state_at_or_before(sample.t_ns)) {
+        id = AddDvlFactor(&problem, sample, *calibration.dvl, dock, blocks_of(s), s->t_ns);
+      }
+      if (id) {
+        dvl_residuals.push_back(*id);
+      } else {
+        ++result.stats.dvl_skipped;
       }
     }
   }
@@ -201,9 +216,14 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     gated += s->n_gated;
   }
   result.stats.depth_gated =
-      GateDepthResiduals(&problem, estimator_options.depth_gate_chi2, &depth_residuals);
+      GateSensorResiduals(&problem, estimator_options.depth_gate_chi2, &depth_residuals);
   result.stats.depth_used = static_cast<int>(depth_residuals.size());
-  if (gated > 0 || result.stats.depth_gated > 0) ceres::Solve(solver, &problem, &summary);
+  result.stats.dvl_gated =
+      GateSensorResiduals(&problem, estimator_options.dvl_gate_chi2, &dvl_residuals);
+  result.stats.dvl_used = static_cast<int>(dvl_residuals.size());
+  if (gated > 0 || result.stats.depth_gated > 0 || result.stats.dvl_gated > 0) {
+    ceres::Solve(solver, &problem, &summary);
+  }
   result.final_cost = summary.final_cost;
   result.iterations = static_cast<int>(summary.iterations.size());
   result.converged = summary.termination_type == ceres::CONVERGENCE;
@@ -223,8 +243,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     out.t_ns = s->t_ns;
     out.T_D_B = PoseFromBlock(s->pose);
     out.v_D = Eigen::Map<const Eigen::Vector3d>(s->velocity);
-    out.bias.gyro = Eigen::Map<const Eigen::Vector3d>(s->bias);
-    out.bias.accel = Eigen::Map<const Eigen::Vector3d>(s->bias + 3);
+    out.bias = BiasFromBlock(s->bias);
     for (const VisionResidual& r : s->vision) (r.mono ? out.n_mono : out.n_stereo) += 1;
     out.n_gated = s->n_gated;
     if (!s->vision.empty()) last_vision = s->t_ns;

@@ -21,6 +21,8 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.vision.use_mono = est.GetBool("use_mono", e.vision.use_mono);
   e.use_depth = est.GetBool("use_depth", e.use_depth);
   e.depth_gate_chi2 = est.GetNonNegative("depth_gate_chi2", e.depth_gate_chi2);
+  e.use_dvl = est.GetBool("use_dvl", e.use_dvl);
+  e.dvl_gate_chi2 = est.GetNonNegative("dvl_gate_chi2", e.dvl_gate_chi2);
   e.vision.use_stereo = est.GetBool("use_stereo", e.vision.use_stereo);
   e.adaptive_vision_noise.enabled =
       est.GetBool("adaptive_vision_noise", e.adaptive_vision_noise.enabled);

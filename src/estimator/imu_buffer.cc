@@ -23,6 +23,15 @@ void ImuBuffer::DropBefore(int64_t t_ns) {
   while (samples_.size() >= 2 && samples_[1].t_ns <= t_ns) samples_.pop_front();
 }
 
+std::optional<Eigen::Vector3d> ImuBuffer::GyroAt(int64_t t_ns) const {
+  auto it = std::upper_bound(samples_.begin(), samples_.end(), t_ns,
+                             [](int64_t t, const ImuSample& s) { return t < s.t_ns; });
+  if (it == samples_.begin()) return std::nullopt;
+  const ImuSample& held = *std::prev(it);
+  if (t_ns - held.t_ns > max_gap_ns_) return std::nullopt;
+  return held.gyro;
+}
+
 std::optional<ImuPreintegration> ImuBuffer::Preintegrate(int64_t t0_ns, int64_t t1_ns,
                                                          const ImuBias& bias) const {
   if (samples_.empty() || t1_ns <= t0_ns) return std::nullopt;

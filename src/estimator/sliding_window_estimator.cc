@@ -8,7 +8,7 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
-#include "auvdock/estimator/depth_factors.h"
+#include "auvdock/estimator/sensor_factors.h"
 #include "auvdock/estimator/marginal_covariance.h"
 #include "auvdock/estimator/marginalization.h"
 #include "factors/bias_prior_factor.h"
@@ -24,13 +24,6 @@ namespace {
 constexpr double kNsPerSecond = 1e9;
 
 double Seconds(int64_t ns) { return static_cast<double>(ns) / kNsPerSecond; }
-
-ImuBias LoadBias(const double* bias) {
-  ImuBias b;
-  b.gyro = Eigen::Map<const Eigen::Vector3d>(bias);
-  b.accel = Eigen::Map<const Eigen::Vector3d>(bias + 3);
-  return b;
-}
 
 }  // namespace
 
@@ -141,7 +134,7 @@ bool SlidingWindowEstimator::Initialize(const VisionFrame& frame) {
 
 bool SlidingWindowEstimator::AddState(int64_t t_ns) {
   State& previous = *window_.back();
-  const ImuBias bias = LoadBias(previous.bias);
+  const ImuBias bias = BiasFromBlock(previous.bias);
   const std::optional<ImuPreintegration> pim = imu_.Preintegrate(previous.t_ns, t_ns, bias);
   if (!pim) return false;
 
@@ -203,25 +196,60 @@ void SlidingWindowEstimator::AddDepth(const DepthMeasurement& sample) {
   pending_depth_.push_back(sample);
 }
 
+void SlidingWindowEstimator::AddDvl(const DvlMeasurement& sample) {
+  if (!options_.use_dvl || !calibration_.dvl) return;
+  if (!sample.v_S.allFinite()) {
+    ++stats_.dvl_no_lock;
+    return;
+  }
+  if (!pending_dvl_.empty() && sample.t_ns <= pending_dvl_.back().t_ns) {
+    ++stats_.dvl_skipped;
+    return;
+  }
+  pending_dvl_.push_back(sample);
+}
+
+SlidingWindowEstimator::State* SlidingWindowEstimator::StateAtOrBefore(int64_t t_ns) {
+  auto it = std::find_if(window_.rbegin(), window_.rend(),
+                         [&](const std::unique_ptr<State>& s) { return s->t_ns <= t_ns; });
+  return it == window_.rend() ? nullptr : it->get();
+}
+
 std::vector<ceres::ResidualBlockId> SlidingWindowEstimator::AttachDepth(int64_t t_ns) {
   std::vector<ceres::ResidualBlockId> added;
   while (!pending_depth_.empty() && pending_depth_.front().t_ns <= t_ns) {
     const DepthMeasurement sample = pending_depth_.front();
     pending_depth_.pop_front();
-    // The latest state at or before the sample.
-    auto it = std::find_if(window_.rbegin(), window_.rend(),
-                           [&](const std::unique_ptr<State>& s) { return s->t_ns <= sample.t_ns; });
     std::optional<ceres::ResidualBlockId> id;
-    if (it != window_.rend()) {
-      State& state = **it;
+    if (State* state = StateAtOrBefore(sample.t_ns)) {
       id = AddDepthFactor(problem_.get(), sample, *calibration_.depth, dock_,
-                          VisionState(state.pose, state.velocity, &imu_, LoadBias(state.bias)),
-                          state.t_ns);
+                          VisionState(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias)),
+                          state->t_ns);
     }
     if (id) {
       added.push_back(*id);
     } else {
       ++stats_.depth_skipped;
+    }
+  }
+  return added;
+}
+
+std::vector<ceres::ResidualBlockId> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
+  std::vector<ceres::ResidualBlockId> added;
+  while (!pending_dvl_.empty() && pending_dvl_.front().t_ns <= t_ns) {
+    const DvlMeasurement sample = pending_dvl_.front();
+    pending_dvl_.pop_front();
+    std::optional<ceres::ResidualBlockId> id;
+    if (State* state = StateAtOrBefore(sample.t_ns)) {
+      id = AddDvlFactor(problem_.get(), sample, *calibration_.dvl, dock_,
+                        VisionState(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias)),
+                        state->t_ns);
+    }
+    if (id) {
+      added.push_back(*id);
+    } else {
+      ++stats_.dvl_skipped;
     }
   }
   return added;
@@ -250,7 +278,7 @@ EstimatorOutput SlidingWindowEstimator::Output(const State& state) {
   out.t_ns = state.t_ns;
   out.T_D_B = PoseFromBlock(state.pose);
   out.v_D = Eigen::Map<const Eigen::Vector3d>(state.velocity);
-  out.bias = LoadBias(state.bias);
+  out.bias = BiasFromBlock(state.bias);
   for (const VisionResidual& r : state.vision) (r.mono ? out.n_mono : out.n_stereo) += 1;
   out.n_gated = state.n_gated;
   out.seconds_since_vision =
@@ -299,9 +327,10 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
                                options_.window_vision_correlation_time_s, frame_interval_s);
   state->vision = AddVisionFactors(problem_.get(), frame, rig_, vision,
                                    VisionState(state->pose, state->velocity, &imu_,
-                                               LoadBias(state->bias)),
+                                               BiasFromBlock(state->bias)),
                                    &stats_.skipped_observations);
   std::vector<ceres::ResidualBlockId> depth = AttachDepth(frame.t_ns);
+  std::vector<ceres::ResidualBlockId> dvl = AttachDvl(frame.t_ns);
 
   if (!Solve()) {
     ++stats_.solver_failures;
@@ -310,10 +339,13 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   }
   state->n_gated = GateVisionResiduals(problem_.get(), options_.mono_gate_chi2,
                                        options_.stereo_gate_chi2, &state->vision);
-  const int depth_gated = GateDepthResiduals(problem_.get(), options_.depth_gate_chi2, &depth);
+  const int depth_gated = GateSensorResiduals(problem_.get(), options_.depth_gate_chi2, &depth);
   stats_.depth_gated += depth_gated;
   stats_.depth_used += static_cast<int>(depth.size());
-  if ((state->n_gated > 0 || depth_gated > 0) && !Solve()) {
+  const int dvl_gated = GateSensorResiduals(problem_.get(), options_.dvl_gate_chi2, &dvl);
+  stats_.dvl_gated += dvl_gated;
+  stats_.dvl_used += static_cast<int>(dvl.size());
+  if ((state->n_gated > 0 || depth_gated > 0 || dvl_gated > 0) && !Solve()) {
     ++stats_.solver_failures;
     Reset("solver failed at " + std::to_string(frame.t_ns) + " ns (after gating)");
     return std::nullopt;
@@ -365,7 +397,7 @@ std::optional<Pose3> SlidingWindowEstimator::PropagatedPose(int64_t t_ns) const 
   const State& newest = *window_.back();
   if (t_ns < newest.t_ns) return std::nullopt;
   if (t_ns == newest.t_ns) return PoseFromBlock(newest.pose);
-  const ImuBias bias = LoadBias(newest.bias);
+  const ImuBias bias = BiasFromBlock(newest.bias);
   const std::optional<ImuPreintegration> pim = imu_.Preintegrate(newest.t_ns, t_ns, bias);
   if (!pim) return std::nullopt;
   NavState nav;

@@ -79,6 +79,7 @@ std::optional<ImuPoseShift> ImuShiftFromState(const VisionState& state, int64_t 
   shift.dt_s = pim->sum_dt();
   shift.delta_q = pim->delta_q();
   shift.delta_p = pim->delta_p();
+  shift.delta_v = pim->delta_v();
   return shift;
 }
 

@@ -120,8 +120,10 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
     for (; k_dvl < n_dvl && SampleTime(k_dvl, s.dvl.rate_hz) <= t_end_ns; ++k_dvl) {
       const int64_t t = SampleTime(k_dvl, s.dvl.rate_hz);
       std::optional<FaultRecord> fault;
-      writer.AddDvl(dvl.Sample(t, trajectory_.At(Seconds(t)), &fault));
+      const std::optional<DvlMeasurement> sample = dvl.Sample(t, trajectory_.At(Seconds(t)), &fault);
       record_fault(fault);
+      if (!sample) continue;  // no bottom lock: no sample
+      writer.AddDvl(*sample);
       ++summary.n_dvl;
     }
     for (; k_acoustic < n_acoustic && SampleTime(k_acoustic, s.acoustic.rate_hz) <= t_end_ns;

@@ -154,6 +154,15 @@ Scenario LoadScenario(const std::string& path) {
   s.dvl_faults.gross_error_probability =
       GetProbability(dvl, "gross_error_probability", s.dvl_faults.gross_error_probability);
   s.dvl_faults.gross_error_mps = dvl.GetNonNegative("gross_error_mps", s.dvl_faults.gross_error_mps);
+  DvlFaultConfig& df = s.dvl_faults;
+  df.bias_rate_per_min = dvl.GetNonNegative("bias_rate_per_min", df.bias_rate_per_min);
+  df.bias_min_mps = dvl.GetNonNegative("bias_min_mps", df.bias_min_mps);
+  df.bias_max_mps = dvl.GetNonNegative("bias_max_mps", df.bias_max_mps);
+  if (df.bias_max_mps < df.bias_min_mps) dvl.Fail("bias_max_mps", "must be >= bias_min_mps");
+  df.bias_min_s = dvl.GetPositive("bias_min_s", df.bias_min_s);
+  df.bias_max_s = dvl.GetPositive("bias_max_s", df.bias_max_s);
+  if (df.bias_max_s < df.bias_min_s) dvl.Fail("bias_max_s", "must be >= bias_min_s");
+  df.min_altitude_m = dvl.GetNonNegative("min_altitude_m", df.min_altitude_m);
 
   const ConfigNode ac = root.ChildOrEmpty("acoustic");
   s.acoustic.rate_hz = ac.GetPositive("rate_hz", s.acoustic.rate_hz);

@@ -154,6 +154,32 @@ TEST(DockingSimulator, NoiseFreeSensorsAreExact) {
   }
 }
 
+// The DVL's long bias episodes and its bottom-lock loss: every biased sample is listed, and
+// below the minimum altitude there is no sample at all, each missing one listed.
+TEST(DockingSimulator, DvlBiasEpisodesAndBottomLockLossAreListed) {
+  test::TempDir tmp;
+  Scenario scenario = test::ShortScenario(4.0);
+  scenario.dvl_faults.gross_error_probability = 0.0;
+  scenario.dvl_faults.bias_rate_per_min = 600.0;  // one starts almost at once
+  scenario.dvl_faults.bias_min_s = scenario.dvl_faults.bias_max_s = 1.0;
+  DockingSimulator(scenario).Run(tmp.path(), CancellationToken());
+  const Dataset ds = LoadDataset(tmp.path());
+  int bias = 0;
+  for (const auto& f : ds.faults) bias += f.sensor == "dvl0" && f.kind == "bias";
+  EXPECT_GE(bias, 3);  // 1 s episodes at 5 Hz
+  EXPECT_EQ(ds.dvl.size(), 21u);
+
+  test::TempDir low;
+  scenario.dvl_faults.bias_rate_per_min = 0.0;
+  scenario.dvl_faults.min_altitude_m = 1000.0;  // always too close
+  DockingSimulator(scenario).Run(low.path(), CancellationToken());
+  const Dataset none = LoadDataset(low.path());
+  int lost = 0;
+  for (const auto& f : none.faults) lost += f.sensor == "dvl0" && f.kind == "bottom_lock_lost";
+  EXPECT_TRUE(none.dvl.empty());
+  EXPECT_EQ(lost, 21);
+}
+
 TEST(DockingSimulator, InjectedFaultsAreListed) {
   test::TempDir tmp;
   Scenario scenario = test::ShortScenario(4.0);

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "auvdock/sim/depth_simulator.h"
+#include "auvdock/sim/dvl_simulator.h"
 #include "auvdock/sim/docking_simulator.h"
 #include "auvdock/sim/imu_simulator.h"
 #include "auvdock/sim/random_stream.h"
@@ -58,6 +59,17 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
     const int64_t t = simulator.SampleTime(k, scenario.depth.rate_hz);
     if (simulator.Seconds(t) > scenario.duration_s) break;
     run.depth.push_back(depth.Sample(t, simulator.trajectory().At(simulator.Seconds(t))));
+  }
+
+  DvlSimulator dvl(scenario.dvl, scenario.dvl_faults, true, MakeRandomStream(seed, 105));
+  for (int64_t k = 0;; ++k) {
+    const int64_t t = simulator.SampleTime(k, scenario.dvl.rate_hz);
+    if (simulator.Seconds(t) > scenario.duration_s) break;
+    std::optional<FaultRecord> fault;
+    const std::optional<DvlMeasurement> sample =
+        dvl.Sample(t, simulator.trajectory().At(simulator.Seconds(t)), &fault);
+    if (fault) run.dvl_faults.push_back(*fault);
+    if (sample) run.dvl.push_back(*sample);
   }
 
   std::mt19937_64 rng = MakeRandomStream(seed, 102);

@@ -26,6 +26,8 @@ struct SyntheticRun {
   std::vector<VisionFrame> frames;
   std::vector<StampedPose> truth;  // body pose at each frame
   std::vector<DepthMeasurement> depth;  // the scenario's depth sensor (sim/depth_simulator.h)
+  std::vector<DvlMeasurement> dvl;      // the scenario's DVL, gross errors included
+  std::vector<FaultRecord> dvl_faults;  // its faults (sim/dvl_simulator.h)
 };
 
 SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed, double pixel_sigma = 0.3);

@@ -61,17 +61,23 @@ struct BatchResult {
   EstimatorStats stats;  // skipped / gated / used counts
 };
 
+// The navigation sensors' samples of a log, each stream in time order.
+struct NavigationSamples {
+  std::vector<DepthMeasurement> depth;
+  std::vector<DvlMeasurement> dvl;
+};
+
 // frames: every vision frame of the log, in time order (frames without a warm-start state are
-// ignored); imu: all samples in time order; depth: the pressure-depth samples (used with
-// estimator_options.use_depth and the calibration's depth sensor, each on the state at or
-// before it, estimator/depth_factors.h, and gated with the vision). Throws
-// std::invalid_argument without an IMU calibration.
+// ignored); imu: all samples in time order; sensors: the depth and DVL samples (each used with
+// its estimator_options.use_* switch and the calibration's sensor, on the state at or before
+// it, estimator/sensor_factors.h, and gated with the vision). Throws std::invalid_argument
+// without an IMU calibration.
 BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
                         const std::vector<VisionFrame>& frames,
                         const std::vector<ImuSample>& imu,
                         const std::vector<StateRecord>& warm_start,
                         const EstimatorOptions& estimator_options,
                         const BatchSmootherOptions& options = {},
-                        const std::vector<DepthMeasurement>& depth = {});
+                        const NavigationSamples& sensors = {});
 
 }  // namespace auvdock

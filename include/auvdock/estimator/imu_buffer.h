@@ -31,6 +31,11 @@ class ImuBuffer {
   std::optional<ImuPreintegration> Preintegrate(int64_t t0_ns, int64_t t1_ns,
                                                 const ImuBias& bias) const;
 
+  // The gyro sample held at t_ns (the last one at or before it; rad/s, in B, bias not removed):
+  // the body rate a factor at t_ns needs (factors/dvl_factor.h). Nothing when no sample lies
+  // within max_gap_s before t_ns.
+  std::optional<Eigen::Vector3d> GyroAt(int64_t t_ns) const;
+
   // Forgets samples no longer needed for intervals starting at or after t_ns.
   void DropBefore(int64_t t_ns);
 

@@ -8,6 +8,7 @@
 // + sum_k sum_lights w_mono(k)   rho(|r_mono|^2)     mono reprojection of identified dock lights
 // + sum_k sum_lights w_stereo(k) rho(|r_stereo|^2)   triangulated lights against the dock model
 // + sum_depth |r_depth|^2                            pressure depth against the dock's depth
+// + sum_dvl |r_dvl|^2                                DVL velocity over ground, in its frame
 // where every r is whitened by its own noise model (pixel noise, triangulation covariance,
 // preintegrated IMU covariance), rho is a Huber loss, and w are the stage weights
 // (estimator/stage_weighting.h: by default pure information weighting, w = 1). This is the
@@ -20,7 +21,8 @@
 // the oldest state into the prior when the window is full (estimator/marginalization.h), and
 // report the newest pose's marginal covariance (estimator/marginal_covariance.h).
 // Without vision the window carries on on the IMU alone; the covariance grows accordingly.
-// Depth samples (AddDepth) join the state at or before their time (estimator/depth_factors.h).
+// Depth and DVL samples (AddDepth, AddDvl) join the state at or before their time
+// (estimator/sensor_factors.h).
 //
 // Initialisation: at the first frame with a per-frame pose (VisionFrame::T_D_B_initial): that
 // pose, zero velocity and zero biases, each with a prior (EstimatorOptions). The attitude then
@@ -106,11 +108,15 @@ struct EstimatorOptions {
   // dock"). 0 = white errors only.
   double window_vision_floor_px = 0.07;
   double window_vision_correlation_time_s = 1.0;
-  // Pressure depth (estimator/depth_factors.h; needs the calibration's depth sensor): each sample
+  // Pressure depth (estimator/sensor_factors.h; needs the calibration's depth sensor): each sample
   // against the dock's origin_depth_m, at its own time; a whitened residual beyond the gate
   // (chi-square, 1 dof, p = 0.999) after the solve is removed.
   bool use_depth = true;
   double depth_gate_chi2 = 10.83;
+  // DVL velocity over ground (the same, needs the calibration's DVL): 3 dof, p = 0.999. A sample
+  // that is not finite is bottom lock lost: no measurement, counted apart.
+  bool use_dvl = true;
+  double dvl_gate_chi2 = 16.27;
 };
 
 // The estimate at one state.
@@ -142,6 +148,10 @@ struct EstimatorStats {
   int depth_used = 0;     // depth samples in the cost (after gating)
   int depth_gated = 0;    // beyond the depth gate
   int depth_skipped = 0;  // not finite, out of order, before the first state or beyond the IMU
+  int dvl_used = 0;       // DVL samples in the cost (after gating)
+  int dvl_gated = 0;      // beyond the DVL gate
+  int dvl_no_lock = 0;    // not finite: bottom lock lost
+  int dvl_skipped = 0;    // out of order, before the first state or beyond the IMU
   // The adaptive variance factors in use at the end, per light id.
   std::map<int, double> mono_variance_factor;
   std::map<int, double> stereo_variance_factor;
@@ -173,6 +183,8 @@ class SlidingWindowEstimator {
   // samples must reach the estimator in time order: the caller feeds the samples up to the
   // frame's last image before the frame).
   void AddDepth(const DepthMeasurement& sample);
+  // A DVL sample, the same way.
+  void AddDvl(const DvlMeasurement& sample);
 
   // A camera frame (identified lights; possibly none). Returns the newest state's estimate, or
   // nothing before initialisation / after a reset until the next per-frame pose.
@@ -199,6 +211,9 @@ class SlidingWindowEstimator {
   // The pending depth samples up to t_ns onto the states at or before them; returns the
   // residuals added.
   std::vector<ceres::ResidualBlockId> AttachDepth(int64_t t_ns);
+  std::vector<ceres::ResidualBlockId> AttachDvl(int64_t t_ns);
+  // The latest state at or before t_ns, or nullptr.
+  State* StateAtOrBefore(int64_t t_ns);
   EstimatorOutput Output(const State& state);
   // The newest frame's vision residuals, with their leverage on the newest pose (its covariance
   // in the tangent space), into the adaptive noise factors of their lights.
@@ -214,6 +229,7 @@ class SlidingWindowEstimator {
   ImuBuffer imu_;
   std::vector<StateRecord> history_;
   std::deque<DepthMeasurement> pending_depth_;
+  std::deque<DvlMeasurement> pending_dvl_;
   int64_t last_frame_t_ns_ = INT64_MIN;
   int64_t last_vision_t_ns_ = INT64_MIN;
   EstimatorStats stats_;

@@ -1,10 +1,11 @@
-#include "auvdock/estimator/depth_factors.h"
+#include "auvdock/estimator/sensor_factors.h"
 
 #include <cmath>
 #include <memory>
 #include <utility>
 
 #include "factors/depth_factor.h"
+#include "factors/dvl_factor.h"
 #include "factors/time_shifted_factor.h"
 
 namespace auvdock {
@@ -32,8 +33,28 @@ std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
       nullptr, state.pose, state.velocity);
 }
 
-int GateDepthResiduals(ceres::Problem* problem, double gate_chi2,
-                       std::vector<ceres::ResidualBlockId>* residuals) {
+std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
+                                                   const DvlMeasurement& sample,
+                                                   const DvlCalibration& calibration,
+                                                   const DockModel& dock,
+                                                   const VisionState& state, int64_t t_state_ns) {
+  if (!sample.v_S.allFinite() || sample.t_ns < t_state_ns || state.imu == nullptr ||
+      state.velocity == nullptr) {
+    return std::nullopt;
+  }
+  const std::optional<Eigen::Vector3d> gyro = state.imu->GyroAt(sample.t_ns);
+  if (!gyro) return std::nullopt;
+  const std::optional<ImuPoseShift> shift =
+      ImuShiftFromState(state, t_state_ns, sample.t_ns - t_state_ns, dock.gravity_D);
+  if (!shift) return std::nullopt;
+  return problem->AddResidualBlock(
+      DvlFactor::Create(sample.v_S, calibration.sigma_mps, calibration.T_B_S,
+                        *gyro - state.bias.gyro, *shift),
+      nullptr, state.pose, state.velocity);
+}
+
+int GateSensorResiduals(ceres::Problem* problem, double gate_chi2,
+                        std::vector<ceres::ResidualBlockId>* residuals) {
   int gated = 0;
   std::vector<ceres::ResidualBlockId> kept;
   for (const ceres::ResidualBlockId id : *residuals) {

@@ -1,0 +1,48 @@
+// Adds the navigation sensors' samples (pressure depth, DVL) to a Ceres problem and gates them:
+// shared by the sliding window and the batch smoother, as vision_factors.h is for the lights.
+//
+// A sample at time t attaches to the latest state at or before t (t_k): at t = t_k directly on
+// the state's blocks; later, through the IMU's motion over t - t_k (ImuPoseShift,
+// factors/time_shifted_factor.h), so every sample is used at its own time whatever the
+// sensor's rate and clock, without a state of its own. No robust loss: a residual beyond its
+// chi-square gate after a solve is removed instead, and counted.
+//   depth  factors/depth_factor.h  1 residual, on the pose (and the velocity when shifted)
+//   DVL    factors/dvl_factor.h    3 residuals, on the pose and the velocity; the body rate from
+//                                  the gyro held at t minus the state's gyro bias
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <ceres/problem.h>
+
+#include "auvdock/estimator/vision_factors.h"
+#include "auvdock/geometry/dock_model.h"
+#include "auvdock/io/calibration.h"
+#include "auvdock/io/measurements.h"
+
+namespace auvdock {
+
+// The sample's residual on `state` (whose time is t_state_ns <= sample.t_ns); nothing when the
+// sample is not finite or the IMU does not reach its time.
+std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
+                                                     const DepthMeasurement& sample,
+                                                     const DepthCalibration& calibration,
+                                                     const DockModel& dock,
+                                                     const VisionState& state, int64_t t_state_ns);
+
+// The same for a DVL sample; nothing also when the IMU has no gyro sample at its time. A sample
+// that is not finite (bottom lock lost) is no measurement.
+std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
+                                                   const DvlMeasurement& sample,
+                                                   const DvlCalibration& calibration,
+                                                   const DockModel& dock,
+                                                   const VisionState& state, int64_t t_state_ns);
+
+// Removes the residuals whose squared whitened norm exceeds gate_chi2 (0 = no gate) from the
+// problem and from *residuals; returns how many.
+int GateSensorResiduals(ceres::Problem* problem, double gate_chi2,
+                        std::vector<ceres::ResidualBlockId>* residuals);
+
+}  // namespace auvdock
