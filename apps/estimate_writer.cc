@@ -6,6 +6,7 @@
 #include "auvdock/io/decisions_csv.h"
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/pose_covariance_csv.h"
+#include "auvdock/io/rejections_csv.h"
 #include "auvdock/io/staged_directory.h"
 
 namespace fs = std::filesystem;
@@ -25,7 +26,8 @@ EstimateWriter::EstimateWriter(const std::string& out_dir)
     : out_dir_(PrepareDirectory(out_dir)),
       trajectory_(std::make_unique<TumWriter>(out_dir + "/trajectory.tum")),
       covariance_(out_dir + "/covariance.csv", PoseCovarianceCsvHeader()),
-      decisions_(out_dir + "/decisions.csv", DecisionsCsvHeader()) {}
+      decisions_(out_dir + "/decisions.csv", DecisionsCsvHeader()),
+      rejections_(out_dir + "/rejections.csv", RejectionsCsvHeader()) {}
 
 void EstimateWriter::Write(const EstimatorOutput& output, const GoNoGoDecision& decision) {
   trajectory_->Append({output.t_ns, output.T_D_B});
@@ -38,6 +40,10 @@ void EstimateWriter::Write(const EstimatorOutput& output, const GoNoGoDecision& 
 
 void EstimateWriter::WriteNoEstimate(int64_t t_ns, const GoNoGoDecision& decision) {
   decisions_.Line(DecisionsCsvRow({t_ns, decision.go, decision.reason}));
+}
+
+void EstimateWriter::WriteRejections(const std::vector<Rejection>& rejections) {
+  for (const Rejection& r : rejections) rejections_.Line(RejectionsCsvRow(r));
 }
 
 void EstimateWriter::WriteSummary(const nlohmann::json& summary) const {

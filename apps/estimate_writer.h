@@ -7,14 +7,18 @@
 //                    Exp(dtheta) q): position and rotation perturbed in the dock frame. No row
 //                    when the covariance is unavailable (the decision then says so).
 //   decisions.csv    timestamp_ns, GO or NO-GO, reason (every frame)
+//   rejections.csv   timestamp_ns, sensor, statistic, reason: every measurement the estimator
+//                    left out (io/rejections_csv.h)
 //   summary.json     written last, atomically (see WriteSummary)
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "auvdock/estimator/go_no_go.h"
+#include "auvdock/estimator/rejection.h"
 #include "auvdock/io/csv.h"
 #include "auvdock/io/tum_io.h"
 
@@ -26,6 +30,7 @@ class EstimateWriter {
 
   void Write(const EstimatorOutput& output, const GoNoGoDecision& decision);
   void WriteNoEstimate(int64_t t_ns, const GoNoGoDecision& decision);
+  void WriteRejections(const std::vector<Rejection>& rejections);
 
   // summary.json via a temporary file and a rename: never half-written.
   void WriteSummary(const nlohmann::json& summary) const;
@@ -35,6 +40,7 @@ class EstimateWriter {
   std::unique_ptr<TumWriter> trajectory_;
   CsvWriter covariance_;
   CsvWriter decisions_;
+  CsvWriter rejections_;
 };
 
 }  // namespace auvdock::cli

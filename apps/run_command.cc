@@ -66,6 +66,9 @@ void Run(const RunOptions& options) {
       const std::optional<EstimatorOutput> out = estimator.AddVisionFrame(*frame);
       counters.backend_s += Seconds(Clock::now() - t0);
       ++counters.frames;
+      const std::vector<Rejection> rejections = estimator.TakeRejections();
+      counters.rejections += static_cast<int>(rejections.size());
+      writer.WriteRejections(rejections);
       if (out) {
         const GoNoGoDecision decision = go_no_go.Decide(*out);
         counters.go += decision.go;

@@ -16,6 +16,7 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
   summary["frames_in_dataset"] = source.num_frames();
   summary["estimates"] = stats.frames_with_output;
   summary["go_decisions"] = counters.go;
+  summary["rejections"] = counters.rejections;
   summary["unreadable_images"] = source.unreadable_images();
   summary["imu_samples"] = stats.imu_samples;
   summary["skipped"] = {{"dataset_rows", skipped_rows.size()},

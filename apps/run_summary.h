@@ -17,6 +17,7 @@ namespace auvdock::cli {
 struct RunCounters {
   int frames = 0;
   int go = 0;
+  int rejections = 0;  // rows written to rejections.csv
   double backend_s = 0.0;
   double total_s = 0.0;
   bool interrupted = false;

@@ -61,6 +61,8 @@ void Smooth(const SmoothOptions& options) {
     const auto t0 = Clock::now();
     feed.FeedAllUpTo(frame->last_t_ns());
     estimator.AddVisionFrame(*frame);
+    // The warm start's own rejections are not this command's: the batch gates again below.
+    estimator.TakeRejections();
     counters.backend_s += Seconds(Clock::now() - t0);
     ++counters.frames;
     frames.push_back(std::move(*frame));
@@ -84,6 +86,8 @@ void Smooth(const SmoothOptions& options) {
   counters.backend_s += Seconds(Clock::now() - t0);
   if (!options.quiet) std::fprintf(stderr, "\n");
 
+  writer.WriteRejections(result.rejections);
+  counters.rejections = static_cast<int>(result.rejections.size());
   GoNoGo go_no_go(config.go_no_go);
   size_t next_output = 0;
   for (const VisionFrame& frame : frames) {

@@ -165,7 +165,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   const auto blocks_of = [&](BatchState* s) {
     return VisionState(s->pose, s->velocity, &buffer, BiasFromBlock(s->bias));
   };
-  std::vector<ceres::ResidualBlockId> depth_residuals;
+  std::vector<SensorResidual> depth_residuals;
   if (estimator_options.use_depth && calibration.depth) {
     for (const DepthMeasurement& sample : sensors.depth) {
       std::optional<ceres::ResidualBlockId> id;
@@ -173,13 +173,14 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
         id = AddDepthFactor(&problem, sample, *calibration.depth, dock, blocks_of(s), s->t_ns);
       }
       if (id) {
-        depth_residuals.push_back(*id);
+        depth_residuals.push_back({*id, sample.t_ns});
       } else {
         ++result.stats.depth_skipped;
+        result.rejections.push_back({sample.t_ns, calibration.depth->name, kNoStatistic, kNoStateReason});
       }
     }
   }
-  std::vector<ceres::ResidualBlockId> dvl_residuals;
+  std::vector<SensorResidual> dvl_residuals;
   if (estimator_options.use_dvl && calibration.dvl) {
     for (const DvlMeasurement& sample : sensors.dvl) {
       if (!sample.v_S.allFinite()) {
@@ -191,9 +192,10 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
         id = AddDvlFactor(&problem, sample, *calibration.dvl, dock, blocks_of(s), s->t_ns);
       }
       if (id) {
-        dvl_residuals.push_back(*id);
+        dvl_residuals.push_back({*id, sample.t_ns});
       } else {
         ++result.stats.dvl_skipped;
+        result.rejections.push_back({sample.t_ns, calibration.dvl->name, kNoStatistic, kNoStateReason});
       }
     }
   }
@@ -206,24 +208,46 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   solver.logging_type = ceres::SILENT;
   ProgressCallback callback(options.progress);
   solver.callbacks.push_back(&callback);
+  // The navigation sensors are gated twice: at the warm start (the window's estimate, good
+  // enough to tell a DVL spike of 0.3 m/s from 1 cm/s noise) before the solve, so that spikes
+  // without a robust loss do not pull the whole batch and drag clean samples past the gate with
+  // them, and again after it.
+  const auto gate_depth = [&] {
+    return depth_residuals.empty()
+               ? 0
+               : GateSensorResiduals(&problem, estimator_options.depth_gate_chi2,
+                                     calibration.depth->name, &depth_residuals,
+                                     &result.rejections);
+  };
+  const auto gate_dvl = [&] {
+    return dvl_residuals.empty()
+               ? 0
+               : GateSensorResiduals(&problem, estimator_options.dvl_gate_chi2,
+                                     calibration.dvl->name, &dvl_residuals, &result.rejections);
+  };
+  result.stats.depth_gated = gate_depth();
+  result.stats.dvl_gated = gate_dvl();
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
   result.initial_cost = summary.initial_cost;
   int gated = 0;
   for (auto& s : states) {
     s->n_gated = GateVisionResiduals(&problem, estimator_options.mono_gate_chi2,
-                                     estimator_options.stereo_gate_chi2, &s->vision);
+                                     estimator_options.stereo_gate_chi2, &s->vision,
+                                     &result.rejections);
     gated += s->n_gated;
   }
-  result.stats.depth_gated =
-      GateSensorResiduals(&problem, estimator_options.depth_gate_chi2, &depth_residuals);
+  const int depth_gated_after = gate_depth();
+  result.stats.depth_gated += depth_gated_after;
   result.stats.depth_used = static_cast<int>(depth_residuals.size());
-  result.stats.dvl_gated =
-      GateSensorResiduals(&problem, estimator_options.dvl_gate_chi2, &dvl_residuals);
+  const int dvl_gated_after = gate_dvl();
+  result.stats.dvl_gated += dvl_gated_after;
   result.stats.dvl_used = static_cast<int>(dvl_residuals.size());
-  if (gated > 0 || result.stats.depth_gated > 0 || result.stats.dvl_gated > 0) {
+  if (gated > 0 || depth_gated_after > 0 || dvl_gated_after > 0) {
     ceres::Solve(solver, &problem, &summary);
   }
+  std::stable_sort(result.rejections.begin(), result.rejections.end(),
+                   [](const Rejection& a, const Rejection& b) { return a.t_ns < b.t_ns; });
   result.final_cost = summary.final_cost;
   result.iterations = static_cast<int>(summary.iterations.size());
   result.converged = summary.termination_type == ceres::CONVERGENCE;

@@ -53,18 +53,23 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
       nullptr, state.pose, state.velocity);
 }
 
-int GateSensorResiduals(ceres::Problem* problem, double gate_chi2,
-                        std::vector<ceres::ResidualBlockId>* residuals) {
+int GateSensorResiduals(ceres::Problem* problem, double gate_chi2, const std::string& sensor,
+                        std::vector<SensorResidual>* residuals,
+                        std::vector<Rejection>* rejections) {
   int gated = 0;
-  std::vector<ceres::ResidualBlockId> kept;
-  for (const ceres::ResidualBlockId id : *residuals) {
+  std::vector<SensorResidual> kept;
+  for (const SensorResidual& residual : *residuals) {
     double cost = 0.0;
-    problem->EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, nullptr, nullptr);
+    problem->EvaluateResidualBlock(residual.id, /*apply_loss_function=*/false, &cost, nullptr,
+                                   nullptr);
     if (gate_chi2 > 0.0 && 2.0 * cost > gate_chi2) {
-      problem->RemoveResidualBlock(id);
+      problem->RemoveResidualBlock(residual.id);
       ++gated;
+      if (rejections) {
+        rejections->push_back({residual.t_ns, sensor, 2.0 * cost, "beyond the chi-square gate"});
+      }
     } else {
-      kept.push_back(id);
+      kept.push_back(residual);
     }
   }
   *residuals = std::move(kept);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -188,9 +189,11 @@ bool SlidingWindowEstimator::Solve() {
 
 void SlidingWindowEstimator::AddDepth(const DepthMeasurement& sample) {
   if (!options_.use_depth || !calibration_.depth) return;
-  if (!std::isfinite(sample.depth_m) ||
-      (!pending_depth_.empty() && sample.t_ns <= pending_depth_.back().t_ns)) {
+  const bool finite = std::isfinite(sample.depth_m);
+  if (!finite || (!pending_depth_.empty() && sample.t_ns <= pending_depth_.back().t_ns)) {
     ++stats_.depth_skipped;
+    rejections_.push_back({sample.t_ns, calibration_.depth->name, kNoStatistic,
+                           finite ? "out of order or repeated" : "not finite"});
     return;
   }
   pending_depth_.push_back(sample);
@@ -204,6 +207,7 @@ void SlidingWindowEstimator::AddDvl(const DvlMeasurement& sample) {
   }
   if (!pending_dvl_.empty() && sample.t_ns <= pending_dvl_.back().t_ns) {
     ++stats_.dvl_skipped;
+    rejections_.push_back({sample.t_ns, calibration_.dvl->name, kNoStatistic, "out of order or repeated"});
     return;
   }
   pending_dvl_.push_back(sample);
@@ -215,8 +219,8 @@ SlidingWindowEstimator::State* SlidingWindowEstimator::StateAtOrBefore(int64_t t
   return it == window_.rend() ? nullptr : it->get();
 }
 
-std::vector<ceres::ResidualBlockId> SlidingWindowEstimator::AttachDepth(int64_t t_ns) {
-  std::vector<ceres::ResidualBlockId> added;
+std::vector<SensorResidual> SlidingWindowEstimator::AttachDepth(int64_t t_ns) {
+  std::vector<SensorResidual> added;
   while (!pending_depth_.empty() && pending_depth_.front().t_ns <= t_ns) {
     const DepthMeasurement sample = pending_depth_.front();
     pending_depth_.pop_front();
@@ -227,16 +231,17 @@ std::vector<ceres::ResidualBlockId> SlidingWindowEstimator::AttachDepth(int64_t 
                           state->t_ns);
     }
     if (id) {
-      added.push_back(*id);
+      added.push_back({*id, sample.t_ns});
     } else {
       ++stats_.depth_skipped;
+      rejections_.push_back({sample.t_ns, calibration_.depth->name, kNoStatistic, kNoStateReason});
     }
   }
   return added;
 }
 
-std::vector<ceres::ResidualBlockId> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
-  std::vector<ceres::ResidualBlockId> added;
+std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
+  std::vector<SensorResidual> added;
   while (!pending_dvl_.empty() && pending_dvl_.front().t_ns <= t_ns) {
     const DvlMeasurement sample = pending_dvl_.front();
     pending_dvl_.pop_front();
@@ -247,9 +252,10 @@ std::vector<ceres::ResidualBlockId> SlidingWindowEstimator::AttachDvl(int64_t t_
                         state->t_ns);
     }
     if (id) {
-      added.push_back(*id);
+      added.push_back({*id, sample.t_ns});
     } else {
       ++stats_.dvl_skipped;
+      rejections_.push_back({sample.t_ns, calibration_.dvl->name, kNoStatistic, kNoStateReason});
     }
   }
   return added;
@@ -329,8 +335,8 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
                                    VisionState(state->pose, state->velocity, &imu_,
                                                BiasFromBlock(state->bias)),
                                    &stats_.skipped_observations);
-  std::vector<ceres::ResidualBlockId> depth = AttachDepth(frame.t_ns);
-  std::vector<ceres::ResidualBlockId> dvl = AttachDvl(frame.t_ns);
+  std::vector<SensorResidual> depth = AttachDepth(frame.t_ns);
+  std::vector<SensorResidual> dvl = AttachDvl(frame.t_ns);
 
   if (!Solve()) {
     ++stats_.solver_failures;
@@ -338,11 +344,17 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
     return std::nullopt;
   }
   state->n_gated = GateVisionResiduals(problem_.get(), options_.mono_gate_chi2,
-                                       options_.stereo_gate_chi2, &state->vision);
-  const int depth_gated = GateSensorResiduals(problem_.get(), options_.depth_gate_chi2, &depth);
+                                       options_.stereo_gate_chi2, &state->vision, &rejections_);
+  const int depth_gated =
+      depth.empty() ? 0
+                    : GateSensorResiduals(problem_.get(), options_.depth_gate_chi2,
+                                          calibration_.depth->name, &depth, &rejections_);
   stats_.depth_gated += depth_gated;
   stats_.depth_used += static_cast<int>(depth.size());
-  const int dvl_gated = GateSensorResiduals(problem_.get(), options_.dvl_gate_chi2, &dvl);
+  const int dvl_gated =
+      dvl.empty() ? 0
+                  : GateSensorResiduals(problem_.get(), options_.dvl_gate_chi2,
+                                        calibration_.dvl->name, &dvl, &rejections_);
   stats_.dvl_gated += dvl_gated;
   stats_.dvl_used += static_cast<int>(dvl.size());
   if ((state->n_gated > 0 || depth_gated > 0 || dvl_gated > 0) && !Solve()) {
@@ -390,6 +402,10 @@ void SlidingWindowEstimator::UpdateNoiseScales(const State& state, const Matrix6
     (r.mono ? stats_.mono_variance_factor : stats_.stereo_variance_factor)[r.light_id] =
         it->second.factor();
   }
+}
+
+std::vector<Rejection> SlidingWindowEstimator::TakeRejections() {
+  return std::exchange(rejections_, {});
 }
 
 std::optional<Pose3> SlidingWindowEstimator::PropagatedPose(int64_t t_ns) const {

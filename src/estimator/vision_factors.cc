@@ -145,7 +145,8 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
     const ceres::ResidualBlockId id = AddResidual<MonoReprojectionFactor, kMonoResidualSize>(
         problem, std::move(factor), *mono_shift, WeightedHuber(options.huber_sigmas, weights.mono),
         state);
-    added.push_back({id, true, obs.light_id, weights.mono});
+    added.push_back({id, true, obs.light_id, weights.mono, frame.t_ns + frame.mono_dt_ns,
+                     rig.mono->name});
   }
   // The body pose the stereo covariances are evaluated at, once per frame.
   std::optional<Pose3> T_B_D_predicted;
@@ -173,13 +174,15 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
             Factor(options.stereo_variance_factor, obs.light_id) * stereo_scale * covariance,
             rig.stereo_left->T_B_C, light->p_D),
         *stereo_shift, WeightedHuber(options.huber_sigmas, weights.stereo), state);
-    added.push_back({id, false, obs.light_id, weights.stereo});
+    added.push_back({id, false, obs.light_id, weights.stereo,
+                     frame.t_ns + frame.stereo_dt_ns, rig.stereo_left->name});
   }
   return added;
 }
 
 int GateVisionResiduals(ceres::Problem* problem, double mono_gate_chi2, double stereo_gate_chi2,
-                        std::vector<VisionResidual>* residuals) {
+                        std::vector<VisionResidual>* residuals,
+                        std::vector<Rejection>* rejections) {
   int gated = 0;
   std::vector<VisionResidual> kept;
   for (const VisionResidual& residual : *residuals) {
@@ -191,6 +194,12 @@ int GateVisionResiduals(ceres::Problem* problem, double mono_gate_chi2, double s
     if (gate > 0.0 && 2.0 * cost > gate) {
       problem->RemoveResidualBlock(residual.id);
       ++gated;
+      if (rejections) {
+        rejections->push_back({residual.t_ns, residual.sensor, 2.0 * cost,
+                               std::string("light ") + std::to_string(residual.light_id) +
+                                   (residual.mono ? ": beyond the mono gate"
+                                                  : ": beyond the stereo gate")});
+      }
     } else {
       kept.push_back(residual);
     }

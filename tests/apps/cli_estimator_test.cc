@@ -1,6 +1,7 @@
 // End-to-end tests of `auvdock run` and `auvdock smooth` on a short simulated dataset: the files
 // they write, that those files evaluate, and how bad input is handled (skipped, counted, never a
 // NaN pose; a bad option file is one line and exit 2).
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -12,7 +13,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "auvdock/io/dataset.h"
 #include "auvdock/io/decisions_csv.h"
+#include "auvdock/io/rejections_csv.h"
 #include "auvdock/io/pose_covariance_csv.h"
 #include "auvdock/io/tum_io.h"
 #include "tests/testing/run_command.h"
@@ -33,8 +36,10 @@ class EstimatorCli : public ::testing::Test {
     tmp_ = new test::TempDir();
     dataset_ = *tmp_ / "ds";
     const std::string scenario = *tmp_ / "s.yaml";
+    // DVL spikes on a fifth of the samples, so that a few fall in 3 s.
     test::WriteTextFile(scenario, "name: short\nduration_s: 3.0\ndock: " +
-                                      test::SourcePath("data/docks/t_shape.yaml") + "\n");
+                                      test::SourcePath("data/docks/t_shape.yaml") +
+                                      "\ndvl: {gross_error_probability: 0.2}\n");
     const auto r =
         test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset_, "--quiet"});
     ASSERT_EQ(r.exit_status, 0) << r.err;
@@ -81,6 +86,19 @@ TEST_F(EstimatorCli, RunAndSmoothWriteEveryFileAndTheFilesEvaluate) {
     EXPECT_EQ(summary.at("resets").get<int>(), 0) << command;
     // 31 depth samples at 10 Hz; the first ones come before the first state.
     EXPECT_GE(summary.at("depth_samples").at("used").get<int>(), 20) << command;
+    // 16 DVL samples at 5 Hz; every spike the simulator injected is in rejections.csv.
+    EXPECT_GE(summary.at("dvl_samples").at("used").get<int>(), 10) << command;
+    const std::vector<Rejection> rejections = ReadRejectionsCsv(out + "/rejections.csv");
+    EXPECT_EQ(summary.at("rejections").get<int>(), static_cast<int>(rejections.size()));
+    int spikes = 0;
+    for (const FaultRecord& fault : LoadDataset(dataset_).faults) {
+      if (fault.sensor != "dvl0" || fault.kind != "gross_error") continue;
+      ++spikes;
+      EXPECT_TRUE(std::any_of(rejections.begin(), rejections.end(), [&](const Rejection& r) {
+        return r.sensor == "dvl0" && r.t_ns == fault.t_ns && r.statistic > 16.27;
+      })) << command << ": the DVL spike at " << fault.t_ns << " ns is not rejected";
+    }
+    EXPECT_GE(spikes, 1);
 
     const auto e = test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate",
                                      out + "/trajectory.tum", "--covariance",

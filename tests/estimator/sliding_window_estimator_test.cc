@@ -310,6 +310,14 @@ TEST(SlidingWindowEstimatorTest, DvlHoldsTheHorizontalPositionWithoutVisionAndGa
       EXPECT_GE(stats.dvl_gated, static_cast<int>(run.dvl_faults.size()));
       EXPECT_LE(stats.dvl_gated, static_cast<int>(run.dvl_faults.size()) + 2);
       EXPECT_GT(stats.dvl_used, 100);
+      // Each spike is a rejection of dvl0 at its own time, with its chi-square value.
+      const std::vector<Rejection> rejections = estimator.TakeRejections();
+      for (const FaultRecord& fault : run.dvl_faults) {
+        EXPECT_TRUE(std::any_of(rejections.begin(), rejections.end(), [&](const Rejection& r) {
+          return r.sensor == "dvl0" && r.t_ns == fault.t_ns && r.statistic > 16.27;
+        })) << fault.t_ns;
+      }
+      EXPECT_TRUE(estimator.TakeRejections().empty());  // taken once
     } else {
       EXPECT_EQ(stats.dvl_used, 0);
     }

@@ -59,6 +59,7 @@ struct BatchResult {
   double initial_cost = 0.0, final_cost = 0.0;
   bool converged = false;
   EstimatorStats stats;  // skipped / gated / used counts
+  std::vector<Rejection> rejections;  // every measurement left out, in time order
 };
 
 // The navigation sensors' samples of a log, each stream in time order.

@@ -13,10 +13,12 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <ceres/problem.h>
 
+#include "auvdock/estimator/rejection.h"
 #include "auvdock/estimator/vision_factors.h"
 #include "auvdock/geometry/dock_model.h"
 #include "auvdock/io/calibration.h"
@@ -40,9 +42,17 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
                                                    const DockModel& dock,
                                                    const VisionState& state, int64_t t_state_ns);
 
+// A sample's residual in the problem, with the sample's time (for rejections.csv).
+struct SensorResidual {
+  ceres::ResidualBlockId id = nullptr;
+  int64_t t_ns = 0;
+};
+
 // Removes the residuals whose squared whitened norm exceeds gate_chi2 (0 = no gate) from the
-// problem and from *residuals; returns how many.
-int GateSensorResiduals(ceres::Problem* problem, double gate_chi2,
-                        std::vector<ceres::ResidualBlockId>* residuals);
+// problem and from *residuals; returns how many, each also appended to *rejections (sensor:
+// the sensor's name) when given.
+int GateSensorResiduals(ceres::Problem* problem, double gate_chi2, const std::string& sensor,
+                        std::vector<SensorResidual>* residuals,
+                        std::vector<Rejection>* rejections = nullptr);
 
 }  // namespace auvdock

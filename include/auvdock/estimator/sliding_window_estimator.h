@@ -51,6 +51,8 @@
 #include "auvdock/estimator/imu_buffer.h"
 #include "auvdock/estimator/stage_weighting.h"
 #include "auvdock/estimator/adaptive_noise_scale.h"
+#include "auvdock/estimator/rejection.h"
+#include "auvdock/estimator/sensor_factors.h"
 #include "auvdock/estimator/vision_factors.h"
 #include "auvdock/estimator/vision_frame.h"
 #include "auvdock/geometry/dock_model.h"
@@ -197,6 +199,10 @@ class SlidingWindowEstimator {
   // States that have left the window, oldest first, plus the ones still in it (Flush order).
   std::vector<StateRecord> History() const;
 
+  // The measurements rejected since the previous call (gated, out of order, not finite, without
+  // a state at their time), in the order they were rejected; for OUTDIR/rejections.csv.
+  std::vector<Rejection> TakeRejections();
+
   const EstimatorStats& stats() const { return stats_; }
   bool initialized() const { return !window_.empty(); }
 
@@ -210,8 +216,8 @@ class SlidingWindowEstimator {
   void MarginalizeOldest();
   // The pending depth samples up to t_ns onto the states at or before them; returns the
   // residuals added.
-  std::vector<ceres::ResidualBlockId> AttachDepth(int64_t t_ns);
-  std::vector<ceres::ResidualBlockId> AttachDvl(int64_t t_ns);
+  std::vector<SensorResidual> AttachDepth(int64_t t_ns);
+  std::vector<SensorResidual> AttachDvl(int64_t t_ns);
   // The latest state at or before t_ns, or nullptr.
   State* StateAtOrBefore(int64_t t_ns);
   EstimatorOutput Output(const State& state);
@@ -230,6 +236,7 @@ class SlidingWindowEstimator {
   std::vector<StateRecord> history_;
   std::deque<DepthMeasurement> pending_depth_;
   std::deque<DvlMeasurement> pending_dvl_;
+  std::vector<Rejection> rejections_;  // not yet taken
   int64_t last_frame_t_ns_ = INT64_MIN;
   int64_t last_vision_t_ns_ = INT64_MIN;
   EstimatorStats stats_;

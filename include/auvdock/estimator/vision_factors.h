@@ -35,6 +35,7 @@
 
 #include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <ceres/problem.h>
@@ -42,6 +43,7 @@
 #include "auvdock/estimator/imu_buffer.h"
 #include "factors/time_shifted_factor.h"
 #include "auvdock/estimator/stage_weighting.h"
+#include "auvdock/estimator/rejection.h"
 #include "auvdock/estimator/vision_frame.h"
 #include "auvdock/geometry/dock_model.h"
 #include "auvdock/io/calibration.h"
@@ -68,6 +70,8 @@ struct VisionResidual {
   bool mono = false;
   int light_id = -1;
   double weight = 1.0;  // the stage weight on its information
+  int64_t t_ns = 0;     // the image's time
+  std::string sensor;   // the camera's name (the mono camera, or the stereo pair's left)
 };
 
 // What the factors need to know about the rig and the dock. Any camera may be null (without
@@ -115,8 +119,9 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
                                              const VisionState& state, int* n_skipped);
 
 // Removes the residuals beyond their gate (0 = no gate) from the problem and from *residuals;
-// returns how many.
+// returns how many, each also appended to *rejections when given.
 int GateVisionResiduals(ceres::Problem* problem, double mono_gate_chi2, double stereo_gate_chi2,
-                        std::vector<VisionResidual>* residuals);
+                        std::vector<VisionResidual>* residuals,
+                        std::vector<Rejection>* rejections = nullptr);
 
 }  // namespace auvdock

@@ -30,7 +30,7 @@ struct DvlFaultConfig {
   double bias_rate_per_min = 0.0;
   double bias_min_mps = 0.2, bias_max_mps = 0.4;
   double bias_min_s = 1.0, bias_max_s = 5.0;
-  double min_altitude_m = 0.0;
+  double min_altitude_m = 0.3;
 };
 
 class DvlSimulator {
