@@ -31,6 +31,7 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
   summary["dvl_samples"] = {{"used", stats.dvl_used},
                             {"gated", stats.dvl_gated},
                             {"no_bottom_lock", stats.dvl_no_lock},
+                            {"rate_test_rejected", stats.dvl_rate_rejected},
                             {"skipped", stats.dvl_skipped}};
   summary["no_vision_reasons"] = source.no_vision_reasons();
   summary["warnings"] = source.warnings();

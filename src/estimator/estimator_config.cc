@@ -23,6 +23,12 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.depth_gate_chi2 = est.GetNonNegative("depth_gate_chi2", e.depth_gate_chi2);
   e.use_dvl = est.GetBool("use_dvl", e.use_dvl);
   e.dvl_gate_chi2 = est.GetNonNegative("dvl_gate_chi2", e.dvl_gate_chi2);
+  e.dvl_rate_test.enabled = est.GetBool("dvl_rate_test", e.dvl_rate_test.enabled);
+  e.dvl_rate_test.gate_chi2 = est.GetPositive("dvl_rate_gate_chi2", e.dvl_rate_test.gate_chi2);
+  e.dvl_rate_test.accel_sigma_mps2 =
+      est.GetPositive("dvl_rate_accel_sigma_mps2", e.dvl_rate_test.accel_sigma_mps2);
+  e.dvl_rate_test.max_reference_age_s =
+      est.GetPositive("dvl_rate_max_reference_age_s", e.dvl_rate_test.max_reference_age_s);
   e.vision.use_stereo = est.GetBool("use_stereo", e.vision.use_stereo);
   e.adaptive_vision_noise.enabled =
       est.GetBool("adaptive_vision_noise", e.adaptive_vision_noise.enabled);

@@ -44,7 +44,9 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
       dock_(dock),
       options_(options),
       pose_manifold_(std::make_unique<PoseManifold>()),
-      imu_(calibration.imu ? *calibration.imu : ImuCalibration(), options.max_imu_gap_s) {
+      imu_(calibration.imu ? *calibration.imu : ImuCalibration(), options.max_imu_gap_s),
+      dvl_rate_test_(calibration.dvl ? *calibration.dvl : DvlCalibration(),
+                     options.dvl_rate_test) {
   if (options_.window_size < 2 || options_.max_solver_iterations < 1 ||
       !(options_.vision.huber_sigmas > 0.0) || !(options_.max_imu_gap_s > 0.0) ||
       options_.mono_gate_chi2 < 0.0 || options_.stereo_gate_chi2 < 0.0 ||
@@ -78,6 +80,7 @@ void SlidingWindowEstimator::Reset(const std::string& reason) {
     history_.push_back(record);
   }
   window_.clear();
+  dvl_rate_test_.Reset();
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.enable_fast_removal = true;
@@ -97,9 +100,13 @@ void SlidingWindowEstimator::AddImu(const ImuSample& sample) {
     return;
   }
   ++stats_.imu_samples;
-  // Keep what the oldest state's interval needs (or the last second before initialisation).
+  // Keep what the oldest state's interval needs (or the last second before initialisation),
+  // and what the DVL's rate test needs back to its oldest reference.
+  const int64_t rate_test_ns =
+      sample.t_ns - static_cast<int64_t>((options_.dvl_rate_test.max_reference_age_s + 0.5) *
+                                         kNsPerSecond);
   imu_.DropBefore(window_.empty() ? sample.t_ns - static_cast<int64_t>(kNsPerSecond)
-                                  : window_.front()->t_ns);
+                                  : std::min(window_.front()->t_ns, rate_test_ns));
 }
 
 bool SlidingWindowEstimator::Initialize(const VisionFrame& frame) {
@@ -247,9 +254,21 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
     pending_dvl_.pop_front();
     std::optional<ceres::ResidualBlockId> id;
     if (State* state = StateAtOrBefore(sample.t_ns)) {
-      id = AddDvlFactor(problem_.get(), sample, *calibration_.dvl, dock_,
-                        VisionState(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias)),
-                        state->t_ns);
+      const VisionState blocks(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias));
+      const std::optional<ImuPoseShift> shift =
+          ImuShiftFromState(blocks, state->t_ns, sample.t_ns - state->t_ns, dock_.gravity_D);
+      if (shift) {
+        const DvlRateVerdict verdict =
+            dvl_rate_test_.Check(sample, imu_, blocks.bias,
+                                 PoseFromBlock(state->pose).q * shift->delta_q, dock_.gravity_D);
+        if (!verdict.pass) {
+          ++stats_.dvl_rate_rejected;
+          rejections_.push_back(
+              {sample.t_ns, calibration_.dvl->name, verdict.statistic, verdict.reason});
+          continue;
+        }
+      }
+      id = AddDvlFactor(problem_.get(), sample, *calibration_.dvl, dock_, blocks, state->t_ns);
     }
     if (id) {
       added.push_back({*id, sample.t_ns});
@@ -357,6 +376,7 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
                                         calibration_.dvl->name, &dvl, &rejections_);
   stats_.dvl_gated += dvl_gated;
   stats_.dvl_used += static_cast<int>(dvl.size());
+  for (const SensorResidual& kept : dvl) dvl_rate_test_.Confirm(kept.t_ns);
   if ((state->n_gated > 0 || depth_gated > 0 || dvl_gated > 0) && !Solve()) {
     ++stats_.solver_failures;
     Reset("solver failed at " + std::to_string(frame.t_ns) + " ns (after gating)");

@@ -51,6 +51,7 @@
 #include "auvdock/estimator/imu_buffer.h"
 #include "auvdock/estimator/stage_weighting.h"
 #include "auvdock/estimator/adaptive_noise_scale.h"
+#include "auvdock/estimator/dvl_rate_test.h"
 #include "auvdock/estimator/rejection.h"
 #include "auvdock/estimator/sensor_factors.h"
 #include "auvdock/estimator/vision_factors.h"
@@ -119,6 +120,8 @@ struct EstimatorOptions {
   // that is not finite is bottom lock lost: no measurement, counted apart.
   bool use_dvl = true;
   double dvl_gate_chi2 = 16.27;
+  // Seed 001's rate-of-change test on each DVL sample before it joins (estimator/dvl_rate_test.h).
+  DvlRateTestOptions dvl_rate_test;
 };
 
 // The estimate at one state.
@@ -154,6 +157,7 @@ struct EstimatorStats {
   int dvl_gated = 0;      // beyond the DVL gate
   int dvl_no_lock = 0;    // not finite: bottom lock lost
   int dvl_skipped = 0;    // out of order, before the first state or beyond the IMU
+  int dvl_rate_rejected = 0;  // failed the rate-of-change test
   // The adaptive variance factors in use at the end, per light id.
   std::map<int, double> mono_variance_factor;
   std::map<int, double> stereo_variance_factor;
@@ -237,6 +241,7 @@ class SlidingWindowEstimator {
   std::deque<DepthMeasurement> pending_depth_;
   std::deque<DvlMeasurement> pending_dvl_;
   std::vector<Rejection> rejections_;  // not yet taken
+  DvlRateTest dvl_rate_test_;
   int64_t last_frame_t_ns_ = INT64_MIN;
   int64_t last_vision_t_ns_ = INT64_MIN;
   EstimatorStats stats_;

@@ -1,0 +1,87 @@
+// Seed 001's rate-of-change test, for the DVL: a second opinion next to the chi-square gate,
+// which cannot catch a sample that is the only one constraining the velocity (the first sample
+// after start or a reset, a long outage: the solve simply fits it), nor a long, small bias once
+// it has pulled the window.
+//
+// Each sample is predicted from the last sample that passed (the reference, at t_r) and the
+// IMU's velocity change since (the gyro's rotation and the specific force, at the state's bias):
+//   v_B(t_r) = R_B_S v_S(t_r) - w_B(t_r) x p_B_S
+//   v_B(t)   = dR^T (v_B(t_r) + dv) + R_Bt_D g_D dt        (dR = R_Br_Bt, dv: preintegrated)
+//   v_S(t)   = R_S_B (v_B(t) + w_B(t) x p_B_S)
+// and the whitened difference d = v_S - v_S(t) predicted, with covariance
+//   (2 sigma^2 + (accel_sigma dt)^2) I          (two samples' noise; the IMU's unmodelled part:
+//                                                bias error, attitude error on g, per second)
+// is tested against gate_chi2 (3 dof). A sample that passes is a candidate; it becomes the
+// reference when the estimator's own chi-square gate keeps it as well (Confirm), so that a
+// long bias the rate test lets through once the reference has aged is not the next reference
+// if the other sensors disagree with it. A sample that fails against a confirmed reference is
+// rejected; against one that never passed a test itself (the first sample after a start or a
+// gap could have been the spike) the test has no opinion: the sample goes to the gate, and
+// becomes the reference if the gate keeps it, so one bad first sample does not lock the test.
+// A reference older than max_reference_age_s is dropped (the test has little power left: the
+// IMU's velocity error over that time nears the size of the faults it looks for), so a sensor
+// that has really changed is accepted again after that time if the other sensors agree.
+// Without a reference there is no test: the sample is rejected ("no reference") and becomes it.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "auvdock/estimator/imu_buffer.h"
+#include "auvdock/geometry/pose3.h"
+#include "auvdock/imu/imu_preintegration.h"
+#include "auvdock/io/calibration.h"
+#include "auvdock/io/measurements.h"
+
+namespace auvdock {
+
+struct DvlRateTestOptions {
+  bool enabled = true;
+  double gate_chi2 = 16.27;          // 3 dof, p = 0.999
+  double accel_sigma_mps2 = 0.02;    // the IMU's unmodelled velocity error per second
+  double max_reference_age_s = 3.0;
+};
+
+struct DvlRateVerdict {
+  bool pass = false;
+  double statistic = 0.0;  // chi-square (NaN without a reference)
+  std::string reason;      // why it failed; empty when it passed
+};
+
+class DvlRateTest {
+ public:
+  DvlRateTest(const DvlCalibration& calibration, const DvlRateTestOptions& options)
+      : calibration_(calibration), options_(options) {}
+
+  // The sample at its time, with the IMU, the bias and the body attitude R_D_B at that time.
+  DvlRateVerdict Check(const DvlMeasurement& sample, const ImuBuffer& imu, const ImuBias& bias,
+                       const Eigen::Quaterniond& q_D_B, const Eigen::Vector3d& gravity_D);
+
+  // The candidate at t_ns (a sample that passed Check) was kept by the estimator's gate: it
+  // becomes the reference. Candidates that are never confirmed are dropped by the next Check.
+  void Confirm(int64_t t_ns);
+
+  // Forgets the reference (after a reset of the estimator).
+  void Reset() {
+    reference_.reset();
+    candidate_.reset();
+  }
+
+ private:
+  struct Reference {
+    DvlMeasurement sample;
+    Eigen::Vector3d w_B = Eigen::Vector3d::Zero();
+    bool confirmed = false;  // passed a test itself
+  };
+
+  DvlCalibration calibration_;
+  DvlRateTestOptions options_;
+  std::optional<Reference> reference_;
+  std::optional<Reference> candidate_;
+};
+
+}  // namespace auvdock

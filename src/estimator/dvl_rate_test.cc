@@ -1,0 +1,69 @@
+#include "auvdock/estimator/dvl_rate_test.h"
+
+#include <cmath>
+#include <limits>
+
+namespace auvdock {
+
+DvlRateVerdict DvlRateTest::Check(const DvlMeasurement& sample, const ImuBuffer& imu,
+                                  const ImuBias& bias, const Eigen::Quaterniond& q_D_B,
+                                  const Eigen::Vector3d& gravity_D) {
+  DvlRateVerdict verdict;
+  if (!options_.enabled) {
+    verdict.pass = true;
+    return verdict;
+  }
+  const std::optional<Eigen::Vector3d> gyro = imu.GyroAt(sample.t_ns);
+  const Eigen::Vector3d w_B = gyro ? Eigen::Vector3d(*gyro - bias.gyro) : Eigen::Vector3d::Zero();
+  const auto become_reference = [&](bool confirmed) {
+    reference_ = Reference{sample, w_B, confirmed};
+  };
+  candidate_.reset();
+  if (reference_ &&
+      1e-9 * static_cast<double>(sample.t_ns - reference_->sample.t_ns) >
+          options_.max_reference_age_s) {
+    reference_.reset();
+  }
+  const std::optional<ImuPreintegration> pim =
+      reference_ ? imu.Preintegrate(reference_->sample.t_ns, sample.t_ns, bias) : std::nullopt;
+  if (!reference_ || !pim || !gyro) {
+    verdict.statistic = std::numeric_limits<double>::quiet_NaN();
+    verdict.reason = "rate test: no reference sample within " +
+                     std::to_string(options_.max_reference_age_s) +
+                     " s (the first after a start or a gap)";
+    become_reference(false);
+    return verdict;
+  }
+  const Eigen::Quaterniond q_B_S = calibration_.T_B_S.q.normalized();
+  const Eigen::Vector3d& p_B_S = calibration_.T_B_S.p;
+  const double dt = pim->sum_dt();
+  const Eigen::Vector3d v_B_ref = q_B_S * reference_->sample.v_S - reference_->w_B.cross(p_B_S);
+  const Eigen::Vector3d v_B = pim->delta_q().conjugate() * (v_B_ref + pim->delta_v()) +
+                              q_D_B.conjugate() * gravity_D * dt;
+  const Eigen::Vector3d predicted = q_B_S.conjugate() * (v_B + w_B.cross(p_B_S));
+  const double variance = 2.0 * calibration_.sigma_mps * calibration_.sigma_mps +
+                          std::pow(options_.accel_sigma_mps2 * dt, 2);
+  verdict.statistic = (sample.v_S - predicted).squaredNorm() / variance;
+  verdict.pass = verdict.statistic <= options_.gate_chi2;
+  if (verdict.pass) {
+    candidate_ = Reference{sample, w_B, true};
+  } else if (!reference_->confirmed) {
+    // Against a reference that never passed itself the test has no opinion: the gate decides,
+    // and what it keeps becomes the reference.
+    verdict.pass = true;
+    become_reference(false);
+    candidate_ = Reference{sample, w_B, true};
+  } else {
+    verdict.reason = "rate test: jump against the IMU since the last good sample";
+  }
+  return verdict;
+}
+
+void DvlRateTest::Confirm(int64_t t_ns) {
+  if (candidate_ && candidate_->sample.t_ns == t_ns) {
+    reference_ = candidate_;
+    candidate_.reset();
+  }
+}
+
+}  // namespace auvdock

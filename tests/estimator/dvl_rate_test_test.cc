@@ -1,0 +1,117 @@
+#include "auvdock/estimator/dvl_rate_test.h"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+namespace auvdock {
+namespace {
+
+const Eigen::Vector3d kGravity_D(0.0, 0.0, 9.81);
+
+// A level body gliding at 0.5 m/s along x (D = B axes), its IMU at 200 Hz for 20 s, and its DVL
+// (mounted 45 degrees about z, 0.3 m ahead) at 5 Hz with 1 cm/s noise.
+class DvlRateTestTest : public ::testing::Test {
+ protected:
+  DvlRateTestTest() : imu_(ImuCalibration(), 0.1) {
+    calibration_.sigma_mps = 0.01;
+    calibration_.T_B_S = Pose3(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitZ())),
+                               Eigen::Vector3d(0.3, 0.0, 0.0));
+    for (int k = 0; k <= 4000; ++k) {
+      ImuSample s;
+      s.t_ns = k * 5000000LL;
+      s.accel = -kGravity_D;  // specific force of a body at rest or in uniform motion, level
+      imu_.Add(s);
+    }
+  }
+
+  DvlMeasurement Sample(int k, const Eigen::Vector3d& error = Eigen::Vector3d::Zero()) {
+    DvlMeasurement m;
+    m.t_ns = k * 200000000LL;
+    std::normal_distribution<double> n(0.0, calibration_.sigma_mps);
+    m.v_S = calibration_.T_B_S.q.conjugate() * Eigen::Vector3d(0.5, 0.0, 0.0) +
+            Eigen::Vector3d(n(rng_), n(rng_), n(rng_)) + error;
+    return m;
+  }
+
+  DvlRateVerdict Check(DvlRateTest* test, const DvlMeasurement& m) {
+    return test->Check(m, imu_, ImuBias(), Eigen::Quaterniond::Identity(), kGravity_D);
+  }
+
+  DvlCalibration calibration_;
+  ImuBuffer imu_;
+  std::mt19937_64 rng_{7};
+};
+
+TEST_F(DvlRateTestTest, CleanSamplesPassAfterTheFirstAndSpikesFail) {
+  DvlRateTest test(calibration_, DvlRateTestOptions());
+  const DvlRateVerdict first = Check(&test, Sample(0));
+  EXPECT_FALSE(first.pass);
+  EXPECT_TRUE(std::isnan(first.statistic));
+  int passed = 0;
+  for (int k = 1; k < 50; ++k) {
+    const bool spike = k % 10 == 5;
+    const DvlRateVerdict v = Check(&test, Sample(k, spike ? Eigen::Vector3d(0.0, 0.3, 0.0)
+                                                          : Eigen::Vector3d::Zero()));
+    if (spike) {
+      EXPECT_FALSE(v.pass) << k;
+      EXPECT_GT(v.statistic, 100.0) << k;
+    } else {
+      passed += v.pass;
+      if (v.pass) test.Confirm(Sample(k).t_ns);
+    }
+  }
+  EXPECT_GE(passed, 43);  // of 45 clean samples (p = 0.999 each)
+}
+
+// A long small bias (0.2 m/s for 2 s) fails all along: the reference stays the last good sample.
+TEST_F(DvlRateTestTest, ALongSmallBiasFailsWhileTheReferenceIsYoung) {
+  DvlRateTest test(calibration_, DvlRateTestOptions());
+  for (int k = 0; k < 10; ++k) {
+    if (Check(&test, Sample(k)).pass) test.Confirm(Sample(k).t_ns);
+  }
+  for (int k = 10; k < 20; ++k) {
+    const DvlRateVerdict v = Check(&test, Sample(k, Eigen::Vector3d(0.2, 0.0, 0.0)));
+    EXPECT_FALSE(v.pass) << k << " " << v.statistic;
+  }
+  EXPECT_TRUE(Check(&test, Sample(20)).pass);  // back to normal: the reference held
+}
+
+// A spike as the very first sample does not lock the test: the next clean sample has no
+// confirmed reference to fail against, passes to the gate, and once kept is the reference.
+TEST_F(DvlRateTestTest, ASpikeFirstDoesNotLockTheTest) {
+  DvlRateTest test(calibration_, DvlRateTestOptions());
+  EXPECT_FALSE(Check(&test, Sample(0, Eigen::Vector3d(0.5, 0.0, 0.0))).pass);
+  const DvlMeasurement second = Sample(1);
+  EXPECT_TRUE(Check(&test, second).pass);  // no opinion against an unconfirmed reference
+  test.Confirm(second.t_ns);
+  for (int k = 2; k < 10; ++k) {
+    const DvlMeasurement m = Sample(k);
+    EXPECT_TRUE(Check(&test, m).pass) << k;
+    test.Confirm(m.t_ns);
+  }
+  EXPECT_FALSE(Check(&test, Sample(10, Eigen::Vector3d(0.0, 0.0, 0.3))).pass);
+}
+
+// An unconfirmed candidate (the gate did not keep it) is not the next reference; a reference
+// older than max_reference_age_s is dropped, so a sensor that really changed is heard again.
+TEST_F(DvlRateTestTest, OnlyConfirmedCandidatesBecomeTheReferenceAndOldOnesExpire) {
+  DvlRateTestOptions options;
+  options.max_reference_age_s = 1.0;
+  DvlRateTest test(calibration_, options);
+  Check(&test, Sample(0));
+  ASSERT_TRUE(Check(&test, Sample(1)).pass);
+  test.Confirm(Sample(1).t_ns);
+  const Eigen::Vector3d changed(0.0, 0.25, 0.0);
+  for (int k = 2; k < 7; ++k) {
+    EXPECT_FALSE(Check(&test, Sample(k, changed)).pass) << k;  // within 1 s of the reference
+  }
+  const DvlRateVerdict expired = Check(&test, Sample(7, changed));  // 1.2 s after it
+  EXPECT_FALSE(expired.pass);
+  EXPECT_TRUE(std::isnan(expired.statistic));
+  EXPECT_TRUE(Check(&test, Sample(8, changed)).pass);  // the changed sensor, consistent again
+}
+
+}  // namespace
+}  // namespace auvdock
