@@ -28,7 +28,9 @@ def tally(dataset, outdir, faults, rejected, clean, clean_rejected):
     rejected_at = defaultdict(set)
     for r in rows(os.path.join(outdir, "rejections.csv")):
         rejected_at[r[1]].add(int(r[0]))
-    for sensor in sorted(set(fault_at) | set(rejected_at)):
+    folders = {d for d in os.listdir(dataset) if d not in ("groundtruth", "imu0") and
+               os.path.isfile(os.path.join(dataset, d, "data.csv"))}
+    for sensor in sorted(folders):
         data = os.path.join(dataset, sensor, "data.csv")
         if not os.path.exists(data):
             continue

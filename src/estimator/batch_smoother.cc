@@ -92,7 +92,8 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
                         const NavigationSamples& sensors) {
   if (!calibration.imu) throw std::invalid_argument("SmoothBatch: the calibration has no IMU");
   BatchResult result;
-  ImuBuffer buffer(*calibration.imu, estimator_options.max_imu_gap_s);
+  ImuBuffer buffer(*calibration.imu, estimator_options.max_imu_gap_s,
+                   estimator_options.imu_noise_scale);
   for (const ImuSample& sample : imu) {
     if (!buffer.Add(sample).empty()) ++result.stats.skipped_imu;
   }

@@ -18,6 +18,7 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.mono_gate_chi2 = est.GetNonNegative("mono_gate_chi2", e.mono_gate_chi2);
   e.stereo_gate_chi2 = est.GetNonNegative("stereo_gate_chi2", e.stereo_gate_chi2);
   e.max_imu_gap_s = est.GetPositive("max_imu_gap_s", e.max_imu_gap_s);
+  e.imu_noise_scale = est.GetPositive("imu_noise_scale", e.imu_noise_scale);
   e.vision.use_mono = est.GetBool("use_mono", e.vision.use_mono);
   e.use_depth = est.GetBool("use_depth", e.use_depth);
   e.depth_gate_chi2 = est.GetNonNegative("depth_gate_chi2", e.depth_gate_chi2);

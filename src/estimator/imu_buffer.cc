@@ -1,14 +1,23 @@
 #include "auvdock/estimator/imu_buffer.h"
 
 #include <algorithm>
+#include <cmath>
 #include <iterator>
 #include <stdexcept>
 
 namespace auvdock {
 
-ImuBuffer::ImuBuffer(const ImuCalibration& calibration, double max_gap_s)
-    : noise_(ImuNoiseDensities::FromCalibration(calibration)), max_gap_ns_(static_cast<int64_t>(max_gap_s * 1e9)) {
+ImuBuffer::ImuBuffer(const ImuCalibration& calibration, double max_gap_s, double noise_scale)
+    : noise_(ImuNoiseDensities::FromCalibration(calibration)),
+      max_gap_ns_(static_cast<int64_t>(max_gap_s * 1e9)) {
   if (!(max_gap_s > 0.0)) throw std::invalid_argument("ImuBuffer: max_gap_s must be positive");
+  if (!(noise_scale > 0.0) || !std::isfinite(noise_scale)) {
+    throw std::invalid_argument("ImuBuffer: noise_scale must be positive");
+  }
+  noise_.gyroscope_noise_density *= noise_scale;
+  noise_.gyroscope_random_walk *= noise_scale;
+  noise_.accelerometer_noise_density *= noise_scale;
+  noise_.accelerometer_random_walk *= noise_scale;
 }
 
 std::string ImuBuffer::Add(const ImuSample& sample) {

@@ -44,7 +44,8 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
       dock_(dock),
       options_(options),
       pose_manifold_(std::make_unique<PoseManifold>()),
-      imu_(calibration.imu ? *calibration.imu : ImuCalibration(), options.max_imu_gap_s),
+      imu_(calibration.imu ? *calibration.imu : ImuCalibration(), options.max_imu_gap_s,
+           options.imu_noise_scale),
       dvl_rate_test_(calibration.dvl ? *calibration.dvl : DvlCalibration(),
                      options.dvl_rate_test) {
   if (options_.window_size < 2 || options_.max_solver_iterations < 1 ||

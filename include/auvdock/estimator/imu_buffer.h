@@ -20,7 +20,10 @@ namespace auvdock {
 
 class ImuBuffer {
  public:
-  ImuBuffer(const ImuCalibration& calibration, double max_gap_s);
+  // noise_scale multiplies every noise density and random walk of the calibration (so the
+  // covariances by its square): real IMUs are noisier than their datasheets (EstimatorOptions::
+  // imu_noise_scale).
+  ImuBuffer(const ImuCalibration& calibration, double max_gap_s, double noise_scale = 1.0);
 
   // Appends a sample; returns an empty string, or why it was skipped (not finite, not after the
   // previous sample).
