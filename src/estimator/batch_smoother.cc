@@ -263,6 +263,9 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   const bool covariance_ok = covariance.Compute(blocks, &problem);
 
   int64_t last_vision = INT64_MIN;
+  std::vector<int64_t> dvl_times;  // of the DVL samples kept, for the go/no-go's DVL age
+  for (const SensorResidual& r : dvl_residuals) dvl_times.push_back(r.t_ns);
+  std::sort(dvl_times.begin(), dvl_times.end());
   for (const auto& s : states) {
     EstimatorOutput out;
     out.t_ns = s->t_ns;
@@ -274,6 +277,11 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     if (!s->vision.empty()) last_vision = s->t_ns;
     out.seconds_since_vision =
         last_vision == INT64_MIN ? -1.0 : 1e-9 * static_cast<double>(s->t_ns - last_vision);
+    const auto dvl_after = std::upper_bound(dvl_times.begin(), dvl_times.end(), s->t_ns);
+    out.seconds_since_dvl =
+        dvl_after == dvl_times.begin()
+            ? -1.0
+            : 1e-9 * static_cast<double>(s->t_ns - *std::prev(dvl_after));
     if (covariance_ok) {
       Eigen::Matrix<double, 6, 6, Eigen::RowMajor> cov;
       if (covariance.GetCovarianceMatrixInTangentSpace({s->pose}, cov.data()) && cov.allFinite()) {

@@ -61,6 +61,8 @@ RunConfig LoadRunConfig(const std::string& path) {
   g.allowed_lateral_error_m = go.GetPositive("allowed_lateral_error_m", g.allowed_lateral_error_m);
   g.max_yaw_3sigma_rad = go.GetPositive("max_yaw_3sigma_rad", g.max_yaw_3sigma_rad);
   g.max_vision_age_s = go.GetPositive("max_vision_age_s", g.max_vision_age_s);
+  g.max_dvl_age_s = go.GetPositive("max_dvl_age_s", g.max_dvl_age_s);
+  g.max_aided_vision_age_s = go.GetPositive("max_aided_vision_age_s", g.max_aided_vision_age_s);
   g.max_gating_rate = go.GetNonNegative("max_gating_rate", g.max_gating_rate);
   g.gating_window_frames = go.GetInt("gating_window_frames", g.gating_window_frames);
   if (g.gating_window_frames < 1) go.Fail("gating_window_frames", "must be at least 1");

@@ -19,7 +19,8 @@ std::string Format(const char* format, double a, double b) {
 
 GoNoGo::GoNoGo(const GoNoGoOptions& options) : options_(options) {
   if (!(options_.allowed_lateral_error_m > 0.0) || !(options_.max_yaw_3sigma_rad > 0.0) ||
-      !(options_.max_vision_age_s > 0.0) || !(options_.max_gating_rate >= 0.0) ||
+      !(options_.max_vision_age_s > 0.0) || !(options_.max_dvl_age_s > 0.0) ||
+      !(options_.max_aided_vision_age_s > 0.0) || !(options_.max_gating_rate >= 0.0) ||
       options_.gating_window_frames < 1) {
     throw std::invalid_argument("GoNoGoOptions: thresholds must be positive");
   }
@@ -38,9 +39,15 @@ GoNoGoDecision GoNoGo::Decide(const EstimatorOutput& output) {
     return {false, "covariance unavailable (rank-deficient or not computed)"};
   }
   if (output.seconds_since_vision < 0.0) return {false, "no vision yet"};
-  if (output.seconds_since_vision > options_.max_vision_age_s) {
-    return {false, Format("no vision for %.2f s (limit %.2f s)", output.seconds_since_vision,
-                          options_.max_vision_age_s)};
+  const bool dvl_aided =
+      output.seconds_since_dvl >= 0.0 && output.seconds_since_dvl <= options_.max_dvl_age_s;
+  if (output.seconds_since_vision > options_.max_vision_age_s && !dvl_aided) {
+    return {false, Format("no vision for %.2f s (limit %.2f s without the DVL)",
+                          output.seconds_since_vision, options_.max_vision_age_s)};
+  }
+  if (output.seconds_since_vision > options_.max_aided_vision_age_s) {
+    return {false, Format("no vision for %.2f s (limit %.2f s with the DVL)",
+                          output.seconds_since_vision, options_.max_aided_vision_age_s)};
   }
   int used = 0, gated = 0;
   for (const auto& [u, g] : recent_) {
@@ -64,8 +71,15 @@ GoNoGoDecision GoNoGo::Decide(const EstimatorOutput& output) {
     return {false, Format("3-sigma yaw %.4f rad > allowed %.4f rad", yaw_3sigma,
                           options_.max_yaw_3sigma_rad)};
   }
-  return {true, Format("3-sigma lateral %.3f m and yaw %.4f rad within limits", lateral_3sigma,
-                       yaw_3sigma)};
+  std::string reason = Format("3-sigma lateral %.3f m and yaw %.4f rad within limits",
+                              lateral_3sigma, yaw_3sigma);
+  if (output.seconds_since_vision > options_.max_vision_age_s) {
+    char aided[64];
+    std::snprintf(aided, sizeof(aided), " (DVL-aided: no vision for %.2f s)",
+                  output.seconds_since_vision);
+    reason += aided;
+  }
+  return {true, reason};
 }
 
 }  // namespace auvdock

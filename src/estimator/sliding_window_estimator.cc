@@ -309,6 +309,9 @@ EstimatorOutput SlidingWindowEstimator::Output(const State& state) {
   out.n_gated = state.n_gated;
   out.seconds_since_vision =
       last_vision_t_ns_ == INT64_MIN ? -1.0 : Seconds(state.t_ns - last_vision_t_ns_);
+  // A DVL sample used with this frame may be a little after the state (an unsynchronised clock).
+  out.seconds_since_dvl =
+      last_dvl_t_ns_ == INT64_MIN ? -1.0 : std::max(0.0, Seconds(state.t_ns - last_dvl_t_ns_));
   if (options_.compute_covariance) {
     std::string reason;
     const std::optional<Eigen::MatrixXd> covariance =
@@ -377,7 +380,10 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
                                         calibration_.dvl->name, &dvl, &rejections_);
   stats_.dvl_gated += dvl_gated;
   stats_.dvl_used += static_cast<int>(dvl.size());
-  for (const SensorResidual& kept : dvl) dvl_rate_test_.Confirm(kept.t_ns);
+  for (const SensorResidual& kept : dvl) {
+    dvl_rate_test_.Confirm(kept.t_ns);
+    last_dvl_t_ns_ = std::max(last_dvl_t_ns_, kept.t_ns);
+  }
   if ((state->n_gated > 0 || depth_gated > 0 || dvl_gated > 0) && !Solve()) {
     ++stats_.solver_failures;
     Reset("solver failed at " + std::to_string(frame.t_ns) + " ns (after gating)");

@@ -61,6 +61,28 @@ TEST(GoNoGoTest, StaleVisionMissingCovarianceAndNoEstimateAreNoGo) {
   EXPECT_FALSE(decide.NoEstimate("reset").go);
 }
 
+// With the DVL fused, stale vision alone is not NO-GO: the covariance decides, up to
+// max_aided_vision_age_s without lights; a DVL sample too old does not count.
+TEST(GoNoGoTest, RecentDvlLetsVisionBeOlderAndTheCovarianceDecide) {
+  GoNoGo decide;
+  EstimatorOutput aided = PreciseOutput();
+  aided.seconds_since_vision = 4.0;
+  aided.seconds_since_dvl = 0.2;
+  const GoNoGoDecision go = decide.Decide(aided);
+  EXPECT_TRUE(go.go) << go.reason;
+  EXPECT_THAT(go.reason, HasSubstr("DVL-aided: no vision for 4.00 s"));
+  aided.covariance.topLeftCorner<2, 2>() *= 1e4;  // 10 cm 1-sigma: the covariance says no
+  EXPECT_THAT(decide.Decide(aided).reason, HasSubstr("3-sigma lateral"));
+  EstimatorOutput old_dvl = PreciseOutput();
+  old_dvl.seconds_since_vision = 4.0;
+  old_dvl.seconds_since_dvl = 2.0;
+  EXPECT_THAT(decide.Decide(old_dvl).reason, HasSubstr("without the DVL"));
+  EstimatorOutput too_long = PreciseOutput();
+  too_long.seconds_since_vision = 12.0;
+  too_long.seconds_since_dvl = 0.1;
+  EXPECT_THAT(decide.Decide(too_long).reason, HasSubstr("limit 10.00 s with the DVL"));
+}
+
 TEST(GoNoGoTest, ManyGatedResidualsInRecentFramesAreNoGo) {
   GoNoGoOptions options;
   options.max_gating_rate = 0.3;

@@ -6,7 +6,13 @@
 //      covariance is NO-GO: the estimator cannot say how wrong it is);
 //   2. recent vision: the newest frame with a used vision residual is at most
 //      max_vision_age_s old (on the IMU alone the error grows without a bound the vehicle
-//      should trust, whatever the covariance says);
+//      should trust, whatever the covariance says). With the DVL fused the horizontal error
+//      is bounded instead (a random walk of the DVL's noise, not the IMU's quadratic drift),
+//      and its covariance is honest (mean NEES 4.1 in the stage without lights, README): so
+//      while a DVL sample was used at most max_dvl_age_s ago, vision up to
+//      max_aided_vision_age_s old is enough, and checks 4-5 decide from the covariance. The cap
+//      keeps a long unlit stretch NO-GO whatever the covariance says: nothing but the DVL then
+//      stands between the vehicle and an unmodelled DVL bias;
 //   3. gating health: over the last gating_window_frames frames, the share of vision residuals
 //      rejected by the chi-square gate is at most max_gating_rate (many rejections mean the
 //      model and the data disagree: misidentified lights, reflections, a bad calibration);
@@ -31,6 +37,8 @@ struct GoNoGoOptions {
   double allowed_lateral_error_m = 0.10;
   double max_yaw_3sigma_rad = 0.05;  // about 3 degrees
   double max_vision_age_s = 0.5;
+  double max_dvl_age_s = 1.0;            // a DVL sample used this recently ...
+  double max_aided_vision_age_s = 10.0;  // ... lets vision be this old
   double max_gating_rate = 0.3;
   int gating_window_frames = 20;
 };

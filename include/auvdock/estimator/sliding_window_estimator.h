@@ -142,6 +142,7 @@ struct EstimatorOutput {
   int n_mono = 0, n_stereo = 0;                 // vision residuals used in this frame
   int n_gated = 0;                              // vision residuals rejected in this frame
   double seconds_since_vision = -1.0;           // age of the newest used vision (-1: never)
+  double seconds_since_dvl = -1.0;              // of the newest used DVL sample (-1: never)
 };
 
 // Why a frame produced no estimate, or what it skipped.
@@ -251,6 +252,7 @@ class SlidingWindowEstimator {
   DvlRateTest dvl_rate_test_;
   int64_t last_frame_t_ns_ = INT64_MIN;
   int64_t last_vision_t_ns_ = INT64_MIN;
+  int64_t last_dvl_t_ns_ = INT64_MIN;
   EstimatorStats stats_;
   // Per light id: the adaptive variance factors of its mono pixels and its stereo points.
   std::map<int, AdaptiveNoiseScale> mono_noise_;
