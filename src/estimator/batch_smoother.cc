@@ -151,7 +151,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     if (f != frame_at.end()) {
       const ImuBias bias = BiasFromBlock(s->bias);
       s->vision = AddVisionFactors(&problem, *f->second, rig, vision_options,
-                                   VisionState(s->pose, s->velocity, &buffer, bias),
+                                   StateBlocks(s->pose, s->velocity, &buffer, bias),
                                    &result.stats.skipped_observations);
     }
   }
@@ -164,7 +164,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     return after == states.begin() ? nullptr : std::prev(after)->get();
   };
   const auto blocks_of = [&](BatchState* s) {
-    return VisionState(s->pose, s->velocity, &buffer, BiasFromBlock(s->bias));
+    return StateBlocks(s->pose, s->velocity, &buffer, BiasFromBlock(s->bias));
   };
   std::vector<SensorResidual> depth_residuals;
   if (estimator_options.use_depth && calibration.depth) {

@@ -14,7 +14,7 @@ std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
                                                      const DepthMeasurement& sample,
                                                      const DepthCalibration& calibration,
                                                      const DockModel& dock,
-                                                     const VisionState& state, int64_t t_state_ns) {
+                                                     const StateBlocks& state, int64_t t_state_ns) {
   if (!std::isfinite(sample.depth_m) || sample.t_ns < t_state_ns) return std::nullopt;
   const std::optional<ImuPoseShift> shift =
       ImuShiftFromState(state, t_state_ns, sample.t_ns - t_state_ns, dock.gravity_D);
@@ -37,7 +37,7 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
                                                    const DvlMeasurement& sample,
                                                    const DvlCalibration& calibration,
                                                    const DockModel& dock,
-                                                   const VisionState& state, int64_t t_state_ns) {
+                                                   const StateBlocks& state, int64_t t_state_ns) {
   if (!sample.v_S.allFinite() || sample.t_ns < t_state_ns || state.imu == nullptr ||
       state.velocity == nullptr) {
     return std::nullopt;

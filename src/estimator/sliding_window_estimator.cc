@@ -235,7 +235,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDepth(int64_t t_ns) {
     std::optional<ceres::ResidualBlockId> id;
     if (State* state = StateAtOrBefore(sample.t_ns)) {
       id = AddDepthFactor(problem_.get(), sample, *calibration_.depth, dock_,
-                          VisionState(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias)),
+                          StateBlocks(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias)),
                           state->t_ns);
     }
     if (id) {
@@ -255,7 +255,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
     pending_dvl_.pop_front();
     std::optional<ceres::ResidualBlockId> id;
     if (State* state = StateAtOrBefore(sample.t_ns)) {
-      const VisionState blocks(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias));
+      const StateBlocks blocks(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias));
       const std::optional<ImuPoseShift> shift =
           ImuShiftFromState(blocks, state->t_ns, sample.t_ns - state->t_ns, dock_.gravity_D);
       if (shift) {
@@ -355,7 +355,7 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
       CorrelatedVisionVariance(options_.window_vision_floor_px,
                                options_.window_vision_correlation_time_s, frame_interval_s);
   state->vision = AddVisionFactors(problem_.get(), frame, rig_, vision,
-                                   VisionState(state->pose, state->velocity, &imu_,
+                                   StateBlocks(state->pose, state->velocity, &imu_,
                                                BiasFromBlock(state->bias)),
                                    &stats_.skipped_observations);
   std::vector<SensorResidual> depth = AttachDepth(frame.t_ns);

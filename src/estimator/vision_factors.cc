@@ -54,7 +54,7 @@ double Factor(const std::map<int, double>& factors, int light_id) {
 template <typename Factor, int kResiduals>
 ceres::ResidualBlockId AddResidual(ceres::Problem* problem, std::unique_ptr<Factor> factor,
                                    const ImuPoseShift& shift, ceres::LossFunction* loss,
-                                   const VisionState& state) {
+                                   const StateBlocks& state) {
   if (shift.dt_s == 0.0) {
     return problem->AddResidualBlock(
         new ceres::AutoDiffCostFunction<Factor, kResiduals, kPoseSize>(factor.release()), loss,
@@ -66,22 +66,6 @@ ceres::ResidualBlockId AddResidual(ceres::Problem* problem, std::unique_ptr<Fact
 }
 
 }  // namespace
-
-std::optional<ImuPoseShift> ImuShiftFromState(const VisionState& state, int64_t t_state_ns,
-                                              int64_t dt_ns, const Eigen::Vector3d& gravity_D) {
-  ImuPoseShift shift;
-  shift.gravity_D = gravity_D;
-  if (dt_ns <= 0) return shift;
-  if (state.imu == nullptr || state.velocity == nullptr) return std::nullopt;
-  const std::optional<ImuPreintegration> pim =
-      state.imu->Preintegrate(t_state_ns, t_state_ns + dt_ns, state.bias);
-  if (!pim) return std::nullopt;
-  shift.dt_s = pim->sum_dt();
-  shift.delta_q = pim->delta_q();
-  shift.delta_p = pim->delta_p();
-  shift.delta_v = pim->delta_v();
-  return shift;
-}
 
 double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
                                 double frame_interval_s) {
@@ -97,7 +81,7 @@ double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
 std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const VisionFrame& frame,
                                              const VisionRig& rig,
                                              const VisionFactorOptions& options,
-                                             const VisionState& state, int* n_skipped) {
+                                             const StateBlocks& state, int* n_skipped) {
   std::vector<VisionResidual> added;
   const bool mono = options.use_mono && rig.mono != nullptr;
   const bool stereo = options.use_stereo && rig.stereo_left != nullptr;

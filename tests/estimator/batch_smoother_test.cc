@@ -89,7 +89,7 @@ TEST(VisionFactorsTest, CorrelatedPixelVarianceDeweightsMonoAndStereoResiduals) 
     options.correlated_pixel_variance = correlated_pixel_variance;
     int skipped = 0;
     const std::vector<VisionResidual> residuals =
-        AddVisionFactors(&problem, frame, rig, options, VisionState(pose), &skipped);
+        AddVisionFactors(&problem, frame, rig, options, StateBlocks(pose), &skipped);
     EXPECT_EQ(skipped, 0);
     EXPECT_EQ(residuals.size(), 2u);
     std::array<double, 2> chi2{};  // mono, stereo

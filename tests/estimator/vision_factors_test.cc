@@ -76,7 +76,7 @@ TEST(VisionFactorsTest, StereoCovarianceIsTakenAtThePredictedLight) {
     options.stereo_covariance_at_prediction = at_prediction;
     int skipped = 0;
     const std::vector<VisionResidual> residuals =
-        AddVisionFactors(&problem.problem, frame, rig, options, VisionState(pose), &skipped);
+        AddVisionFactors(&problem.problem, frame, rig, options, StateBlocks(pose), &skipped);
     ASSERT_EQ(residuals.size(), 1u);
     double cost = 0.0;
     problem.problem.EvaluateResidualBlock(residuals[0].id, false, &cost, nullptr, nullptr);
@@ -118,7 +118,7 @@ TEST(VisionFactorsTest, MonoLightBehindTheCameraAtTheEstimateIsSkipped) {
   options.use_stereo = false;
   int skipped = 0;
   const std::vector<VisionResidual> residuals =
-      AddVisionFactors(&problem.problem, frame, rig, options, VisionState(pose), &skipped);
+      AddVisionFactors(&problem.problem, frame, rig, options, StateBlocks(pose), &skipped);
   EXPECT_EQ(residuals.size(), 1u);
   EXPECT_EQ(skipped, 1);
   double cost = -1.0;

@@ -56,7 +56,7 @@ ImuPoseShift ShiftFromImu(const ConstantMotion& m, double dt, int steps) {
   return shift;
 }
 
-void StateBlocks(const ConstantMotion& m, double* pose, double* velocity) {
+void SetStateBlocks(const ConstantMotion& m, double* pose, double* velocity) {
   PoseToBlock(Pose3(m.q0, m.p0), pose);
   for (int i = 0; i < 3; ++i) velocity[i] = m.v0[i];
 }
@@ -67,7 +67,7 @@ TEST(DvlFactorTest, ResidualIsTheWhitenedVelocityErrorInTheSensorFrame) {
   const ConstantMotion m;
   const Pose3 T_B_S = DvlMounting();
   double pose[kPoseSize], velocity[kVelocitySize];
-  StateBlocks(m, pose, velocity);
+  SetStateBlocks(m, pose, velocity);
   const Eigen::Vector3d v_S = m.DvlVelocity(0.0, T_B_S);
   double r[3];
   ASSERT_TRUE(DvlFactor(v_S, 0.01, T_B_S, m.w_B)(pose, velocity, r));
@@ -97,7 +97,7 @@ TEST(DvlFactorTest, ASampleAfterTheStateIsMetThroughTheImuShift) {
   const ConstantMotion m;
   const Pose3 T_B_S = DvlMounting();
   double pose[kPoseSize], velocity[kVelocitySize];
-  StateBlocks(m, pose, velocity);
+  SetStateBlocks(m, pose, velocity);
   const double dt = 0.15;
   const Eigen::Vector3d v_S = m.DvlVelocity(dt, T_B_S);
   double r[3];
@@ -118,7 +118,7 @@ TEST(DvlFactorTest, JacobiansPassTheGradientCheckerWithThePoseManifold) {
   std::vector<const ceres::Manifold*> manifolds = {&manifold, nullptr};
   const ceres::GradientChecker checker(cost.get(), &manifolds, ceres::NumericDiffOptions());
   double pose[kPoseSize], velocity[kVelocitySize];
-  StateBlocks(m, pose, velocity);
+  SetStateBlocks(m, pose, velocity);
   const double* parameters[2] = {pose, velocity};
   ceres::GradientChecker::ProbeResults results;
   EXPECT_TRUE(checker.Probe(parameters, 1e-7, &results)) << results.error_log;

@@ -32,7 +32,7 @@ std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
                                                      const DepthMeasurement& sample,
                                                      const DepthCalibration& calibration,
                                                      const DockModel& dock,
-                                                     const VisionState& state, int64_t t_state_ns);
+                                                     const StateBlocks& state, int64_t t_state_ns);
 
 // The same for a DVL sample; nothing also when the IMU has no gyro sample at its time. A sample
 // that is not finite (bottom lock lost) is no measurement.
@@ -40,7 +40,7 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
                                                    const DvlMeasurement& sample,
                                                    const DvlCalibration& calibration,
                                                    const DockModel& dock,
-                                                   const VisionState& state, int64_t t_state_ns);
+                                                   const StateBlocks& state, int64_t t_state_ns);
 
 // A sample's residual in the problem, with the sample's time (for rejections.csv).
 struct SensorResidual {

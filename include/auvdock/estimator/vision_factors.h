@@ -44,6 +44,7 @@
 #include "factors/time_shifted_factor.h"
 #include "auvdock/estimator/stage_weighting.h"
 #include "auvdock/estimator/rejection.h"
+#include "auvdock/estimator/state_blocks.h"
 #include "auvdock/estimator/vision_frame.h"
 #include "auvdock/geometry/dock_model.h"
 #include "auvdock/io/calibration.h"
@@ -90,25 +91,6 @@ struct VisionRig {
 double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
                                 double frame_interval_s);
 
-// The state a frame's residuals attach to: its pose block and, for images taken after the
-// state's time, its velocity block, the IMU and the bias to preintegrate [t, t + dt] at (the
-// state's current bias estimate). velocity and imu may be null for a synchronised frame.
-struct VisionState {
-  explicit VisionState(double* pose_block, double* velocity_block = nullptr,
-                       const ImuBuffer* imu_buffer = nullptr, const ImuBias& state_bias = {})
-      : pose(pose_block), velocity(velocity_block), imu(imu_buffer), bias(state_bias) {}
-  double* pose;
-  double* velocity;
-  const ImuBuffer* imu;
-  ImuBias bias;
-};
-
-// The IMU's motion from the state's time t_state_ns to dt_ns later (factors/time_shifted_factor.h):
-// an identity shift for dt_ns <= 0, nothing when the state has no velocity block or IMU, or the
-// IMU does not cover the interval.
-std::optional<ImuPoseShift> ImuShiftFromState(const VisionState& state, int64_t t_state_ns,
-                                              int64_t dt_ns, const Eigen::Vector3d& gravity_D);
-
 // Adds the frame's residuals on the state's blocks (already in the problem). Observations with
 // an unknown light id or non-finite values, mono observations of a light behind the camera at
 // the current estimate, and observations of an image whose time the IMU does not reach, are
@@ -116,7 +98,7 @@ std::optional<ImuPoseShift> ImuShiftFromState(const VisionState& state, int64_t 
 std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const VisionFrame& frame,
                                              const VisionRig& rig,
                                              const VisionFactorOptions& options,
-                                             const VisionState& state, int* n_skipped);
+                                             const StateBlocks& state, int* n_skipped);
 
 // Removes the residuals beyond their gate (0 = no gate) from the problem and from *residuals;
 // returns how many, each also appended to *rejections when given.

@@ -1,0 +1,40 @@
+// One estimator state's Ceres parameter blocks as the measurement factors see them (vision,
+// depth, DVL: estimator/vision_factors.h, estimator/sensor_factors.h), and the IMU's motion from
+// the state's time to a measurement's own time.
+//
+// A measurement at t >= t_k attaches to state k: at t = t_k directly on its blocks, later through
+// the IMU preintegrated over [t_k, t] at the state's current bias estimate (ImuPoseShift,
+// factors/time_shifted_factor.h), so that no extra state is needed for it.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+
+#include <Eigen/Core>
+
+#include "auvdock/estimator/imu_buffer.h"
+#include "auvdock/imu/imu_preintegration.h"
+#include "factors/time_shifted_factor.h"
+
+namespace auvdock {
+
+// The pose block (factors/pose_manifold.h) and, for measurements after the state's time, its
+// velocity block, the IMU and the bias to preintegrate at. velocity and imu may be null for a
+// measurement at the state's own time.
+struct StateBlocks {
+  explicit StateBlocks(double* pose_block, double* velocity_block = nullptr,
+                       const ImuBuffer* imu_buffer = nullptr, const ImuBias& state_bias = {})
+      : pose(pose_block), velocity(velocity_block), imu(imu_buffer), bias(state_bias) {}
+  double* pose;
+  double* velocity;
+  const ImuBuffer* imu;
+  ImuBias bias;
+};
+
+// The IMU's motion from the state's time t_state_ns to dt_ns later: an identity shift for
+// dt_ns <= 0, nothing when the state has no velocity block or IMU, or the IMU does not cover
+// the interval.
+std::optional<ImuPoseShift> ImuShiftFromState(const StateBlocks& state, int64_t t_state_ns,
+                                              int64_t dt_ns, const Eigen::Vector3d& gravity_D);
+
+}  // namespace auvdock
