@@ -169,6 +169,11 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   std::vector<SensorResidual> depth_residuals;
   if (estimator_options.use_depth && calibration.depth) {
     for (const DepthMeasurement& sample : sensors.depth) {
+      if (const std::string problem = ImplausibleDepth(sample); !problem.empty()) {
+        ++result.stats.depth_skipped;
+        result.rejections.push_back({sample.t_ns, calibration.depth->name, kNoStatistic, problem});
+        continue;
+      }
       std::optional<ceres::ResidualBlockId> id;
       if (BatchState* s = state_at_or_before(sample.t_ns)) {
         id = AddDepthFactor(&problem, sample, *calibration.depth, dock, blocks_of(s), s->t_ns);
@@ -183,9 +188,15 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   }
   std::vector<SensorResidual> dvl_residuals;
   if (estimator_options.use_dvl && calibration.dvl) {
+    HeldDvlReadingCheck held;
     for (const DvlMeasurement& sample : sensors.dvl) {
       if (!sample.v_S.allFinite()) {
         ++result.stats.dvl_no_lock;
+        continue;
+      }
+      if (const std::string problem = held.Check(sample); !problem.empty()) {
+        ++result.stats.dvl_skipped;
+        result.rejections.push_back({sample.t_ns, calibration.dvl->name, kNoStatistic, problem});
         continue;
       }
       std::optional<ceres::ResidualBlockId> id;

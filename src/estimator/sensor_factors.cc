@@ -53,6 +53,12 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
       nullptr, state.pose, state.velocity);
 }
 
+std::string ImplausibleDepth(const DepthMeasurement& sample) {
+  if (!std::isfinite(sample.depth_m)) return "not finite";
+  if (sample.depth_m < -0.5) return "above the surface by more than 0.5 m";
+  return "";
+}
+
 int GateSensorResiduals(ceres::Problem* problem, double gate_chi2, const std::string& sensor,
                         std::vector<SensorResidual>* residuals,
                         std::vector<Rejection>* rejections) {

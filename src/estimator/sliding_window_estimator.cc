@@ -197,13 +197,14 @@ bool SlidingWindowEstimator::Solve() {
 
 void SlidingWindowEstimator::AddDepth(const DepthMeasurement& sample) {
   if (!options_.use_depth || !calibration_.depth) return;
-  const bool finite = std::isfinite(sample.depth_m);
-  if (!finite || (!pending_depth_.empty() && sample.t_ns <= pending_depth_.back().t_ns)) {
+  std::string problem = ImplausibleDepth(sample);
+  if (problem.empty() && sample.t_ns <= last_depth_sample_t_ns_) problem = "out of order or repeated";
+  if (!problem.empty()) {
     ++stats_.depth_skipped;
-    rejections_.push_back({sample.t_ns, calibration_.depth->name, kNoStatistic,
-                           finite ? "out of order or repeated" : "not finite"});
+    rejections_.push_back({sample.t_ns, calibration_.depth->name, kNoStatistic, problem});
     return;
   }
+  last_depth_sample_t_ns_ = sample.t_ns;
   pending_depth_.push_back(sample);
 }
 
@@ -213,11 +214,14 @@ void SlidingWindowEstimator::AddDvl(const DvlMeasurement& sample) {
     ++stats_.dvl_no_lock;
     return;
   }
-  if (!pending_dvl_.empty() && sample.t_ns <= pending_dvl_.back().t_ns) {
+  std::string problem = sample.t_ns <= last_dvl_sample_t_ns_ ? "out of order or repeated" : "";
+  if (problem.empty()) problem = held_dvl_reading_.Check(sample);
+  if (!problem.empty()) {
     ++stats_.dvl_skipped;
-    rejections_.push_back({sample.t_ns, calibration_.dvl->name, kNoStatistic, "out of order or repeated"});
+    rejections_.push_back({sample.t_ns, calibration_.dvl->name, kNoStatistic, problem});
     return;
   }
+  last_dvl_sample_t_ns_ = sample.t_ns;
   pending_dvl_.push_back(sample);
 }
 

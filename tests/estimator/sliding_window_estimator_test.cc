@@ -351,5 +351,34 @@ TEST(SlidingWindowEstimatorTest, ASpikeAsTheFirstDvlSampleDoesNotLockTheGate) {
   }));
 }
 
+// Bad sensor input is rejected with a reason, never used: a depth above the surface, a DVL that
+// holds its reading (exactly zero for the rest of the run), samples that run backwards after
+// earlier ones were already used.
+TEST(SlidingWindowEstimatorTest, ImplausibleHeldAndBackwardSamplesAreRejectedWithAReason) {
+  Scenario scenario = test::DefaultScenario();
+  scenario.duration_s = 6.0;
+  scenario.dvl_faults.gross_error_probability = 0.0;
+  test::SyntheticRun run = test::MakeSyntheticRun(scenario, 4);
+  run.depth[20].depth_m = -3.0;
+  for (size_t k = run.dvl.size() / 2; k < run.dvl.size(); ++k) run.dvl[k].v_S.setZero();
+  const size_t n_held = run.dvl.size() - run.dvl.size() / 2 - 1;  // the first zero is new
+  SlidingWindowEstimator estimator(run.calibration, run.dock);
+  const RunErrors errors = RunEstimator(run, &estimator, 2.0, true, true);
+  // Backwards, after the run: older than samples already taken.
+  estimator.AddDepth(run.depth[5]);
+  estimator.AddDvl(run.dvl[3]);
+  const std::vector<Rejection> rejections = estimator.TakeRejections();
+  const auto count = [&](const std::string& sensor, const std::string& words) {
+    return std::count_if(rejections.begin(), rejections.end(), [&](const Rejection& r) {
+      return r.sensor == sensor && r.reason.find(words) != std::string::npos;
+    });
+  };
+  EXPECT_EQ(count("depth0", "above the surface"), 1);
+  EXPECT_EQ(count("dvl0", "stuck or held"), static_cast<long>(n_held));
+  EXPECT_EQ(count("depth0", "out of order"), 1);
+  EXPECT_EQ(count("dvl0", "out of order"), 1);
+  EXPECT_LT(errors.max_position_m, 0.05);
+}
+
 }  // namespace
 }  // namespace auvdock

@@ -42,6 +42,28 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
                                                    const DockModel& dock,
                                                    const StateBlocks& state, int64_t t_state_ns);
 
+// Why a sample cannot be a measurement whatever the state (empty when it can): a depth above
+// the surface by more than 0.5 m (a pressure sensor reads slightly negative at the surface, a
+// wave or a drifting zero; beyond that the sensor or its conversion is broken).
+std::string ImplausibleDepth(const DepthMeasurement& sample);
+
+// A DVL that repeats its previous reading exactly is stuck or holding a value (a real reading
+// carries noise; a driver that holds the last ping while the DVL has no lock repeats it): the
+// repeat is no new measurement. Check returns why a sample is rejected, or empty.
+class HeldDvlReadingCheck {
+ public:
+  std::string Check(const DvlMeasurement& sample) {
+    const bool repeat = has_previous_ && sample.v_S == previous_;
+    previous_ = sample.v_S;
+    has_previous_ = true;
+    return repeat ? "identical to the previous sample (stuck or held reading)" : "";
+  }
+
+ private:
+  bool has_previous_ = false;
+  Eigen::Vector3d previous_ = Eigen::Vector3d::Zero();
+};
+
 // A sample's residual in the problem, with the sample's time (for rejections.csv).
 struct SensorResidual {
   ceres::ResidualBlockId id = nullptr;

@@ -160,11 +160,11 @@ struct EstimatorStats {
   int covariance_failures = 0;
   int depth_used = 0;     // depth samples in the cost (after gating)
   int depth_gated = 0;    // beyond the depth gate
-  int depth_skipped = 0;  // not finite, out of order, before the first state or beyond the IMU
+  int depth_skipped = 0;  // not finite, above the surface, out of order, no state or IMU
   int dvl_used = 0;       // DVL samples in the cost (after gating)
   int dvl_gated = 0;      // beyond the DVL gate
   int dvl_no_lock = 0;    // not finite: bottom lock lost
-  int dvl_skipped = 0;    // out of order, before the first state or beyond the IMU
+  int dvl_skipped = 0;    // out of order, held, before the first state or beyond the IMU
   int dvl_rate_rejected = 0;  // failed the rate-of-change test
   // The adaptive variance factors in use at the end, per light id.
   std::map<int, double> mono_variance_factor;
@@ -250,6 +250,9 @@ class SlidingWindowEstimator {
   std::deque<DvlMeasurement> pending_dvl_;
   std::vector<Rejection> rejections_;  // not yet taken
   DvlRateTest dvl_rate_test_;
+  HeldDvlReadingCheck held_dvl_reading_;
+  int64_t last_depth_sample_t_ns_ = INT64_MIN;  // of the newest sample taken
+  int64_t last_dvl_sample_t_ns_ = INT64_MIN;
   int64_t last_frame_t_ns_ = INT64_MIN;
   int64_t last_vision_t_ns_ = INT64_MIN;
   int64_t last_dvl_t_ns_ = INT64_MIN;
