@@ -37,19 +37,21 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
                                                    const DvlMeasurement& sample,
                                                    const DvlCalibration& calibration,
                                                    const DockModel& dock,
-                                                   const StateBlocks& state, int64_t t_state_ns) {
+                                                   const StateBlocks& state, int64_t t_state_ns,
+                                                   const ImuPoseShift* shift) {
   if (!sample.v_S.allFinite() || sample.t_ns < t_state_ns || state.imu == nullptr ||
       state.velocity == nullptr) {
     return std::nullopt;
   }
   const std::optional<Eigen::Vector3d> gyro = state.imu->GyroAt(sample.t_ns);
   if (!gyro) return std::nullopt;
-  const std::optional<ImuPoseShift> shift =
-      ImuShiftFromState(state, t_state_ns, sample.t_ns - t_state_ns, dock.gravity_D);
-  if (!shift) return std::nullopt;
+  const std::optional<ImuPoseShift> own_shift =
+      shift ? std::optional<ImuPoseShift>(*shift)
+            : ImuShiftFromState(state, t_state_ns, sample.t_ns - t_state_ns, dock.gravity_D);
+  if (!own_shift) return std::nullopt;
   return problem->AddResidualBlock(
       DvlFactor::Create(sample.v_S, calibration.sigma_mps, calibration.T_B_S,
-                        *gyro - state.bias.gyro, *shift),
+                        *gyro - state.bias.gyro, *own_shift),
       nullptr, state.pose, state.velocity);
 }
 

@@ -273,7 +273,9 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
           continue;
         }
       }
-      id = AddDvlFactor(problem_.get(), sample, *calibration_.dvl, dock_, blocks, state->t_ns);
+      // The shift is the one the rate test used: the IMU is preintegrated once per sample.
+      id = AddDvlFactor(problem_.get(), sample, *calibration_.dvl, dock_, blocks, state->t_ns,
+                        shift ? &*shift : nullptr);
     }
     if (id) {
       added.push_back({*id, sample.t_ns});

@@ -74,6 +74,19 @@ RunErrors RunEstimator(const test::SyntheticRun& run, SlidingWindowEstimator* es
   return errors;
 }
 
+// The last part of a landing without lights: from dark_after_s after the first frame on, the
+// frames carry no vision and no per-frame pose. Returns the first dark time.
+int64_t DarkenFramesAfter(double dark_after_s, test::SyntheticRun* run) {
+  const int64_t t_dark = run->frames.front().t_ns + static_cast<int64_t>(dark_after_s * 1e9);
+  for (VisionFrame& frame : run->frames) {
+    if (frame.t_ns < t_dark) continue;
+    frame.mono.clear();
+    frame.stereo.clear();
+    frame.T_D_B_initial.reset();
+  }
+  return t_dark;
+}
+
 TEST(SlidingWindowEstimatorTest, RecoversTheTrajectoryFromPerturbedInitialPoses) {
   const test::SyntheticRun run = MakeRun(1);
   SlidingWindowEstimator estimator(run.calibration, run.dock);
@@ -240,13 +253,7 @@ TEST(SlidingWindowEstimatorTest, DepthHoldsTheHeightWithoutVisionAndAnOutlierIsG
   test::SyntheticRun run = test::MakeSyntheticRun(scenario, 5);
   for (DepthMeasurement& d : run.depth) d.t_ns += 30000000;
   run.depth[150].depth_m += 1.0;
-  const int64_t t_dark = run.frames.front().t_ns + 16000000000LL;
-  for (VisionFrame& frame : run.frames) {
-    if (frame.t_ns < t_dark) continue;
-    frame.mono.clear();
-    frame.stereo.clear();
-    frame.T_D_B_initial.reset();
-  }
+  const int64_t t_dark = DarkenFramesAfter(16.0, &run);
   double max_z[2] = {0.0, 0.0};
   for (const bool with_depth : {false, true}) {
     SlidingWindowEstimator estimator(run.calibration, run.dock);
@@ -283,13 +290,7 @@ TEST(SlidingWindowEstimatorTest, DvlHoldsTheHorizontalPositionWithoutVisionAndGa
   ASSERT_FALSE(run.dvl_faults.empty());
   run.dvl[40].v_S.setConstant(std::numeric_limits<double>::quiet_NaN());
   run.dvl[41].v_S.setConstant(std::numeric_limits<double>::quiet_NaN());
-  const int64_t t_dark = run.frames.front().t_ns + 16000000000LL;
-  for (VisionFrame& frame : run.frames) {
-    if (frame.t_ns < t_dark) continue;
-    frame.mono.clear();
-    frame.stereo.clear();
-    frame.T_D_B_initial.reset();
-  }
+  const int64_t t_dark = DarkenFramesAfter(16.0, &run);
   double max_xy[2] = {0.0, 0.0};
   for (const bool with_dvl : {false, true}) {
     SlidingWindowEstimator estimator(run.calibration, run.dock);
