@@ -119,6 +119,10 @@ void Smooth(const SmoothOptions& options) {
                       {"initial_cost", result.initial_cost},
                       {"final_cost", result.final_cost},
                       {"converged", result.converged}};
+  summary["vision_errors"] = {{"white_px", result.vision_errors.white_px},
+                              {"slow_px", result.vision_errors.slow_px},
+                              {"coordinates", result.vision_errors.coordinates},
+                              {"lag_pairs", result.vision_errors.lag_pairs}};
   writer.WriteSummary(summary);
   std::printf("smooth: %d frames -> %s: %d estimates in %d segment(s), %d GO; batch %d "
               "iterations, cost %.6g -> %.6g\n",

@@ -3,8 +3,11 @@
 # with --smooth) over several seeds of a scenario, on the full image pipeline:
 #   bash scripts/evaluate_seeds.sh [--scenario FILE] [--seeds "1 2 3"] [--out DIR] [--smooth]
 #                                  [--detector contrast|blob] [--reuse-datasets]
+#                                  [--config FILE] [--commands "run smooth"]
 # (--reuse-datasets: keep OUT/seed_N/dataset from an earlier call of the same scenario instead of
-# simulating again; AUVDOCK_BIN=path/to/auvdock runs another build.)
+# simulating again; --config: estimator options for run and smooth, data/estimator/default.yaml's
+# format; --commands: which of run/smooth to run, e.g. "smooth" alone; AUVDOCK_BIN=path/to/auvdock
+# runs another build.)
 # Needs a built tree (scripts/build.sh). Per seed it simulates, estimates and evaluates into
 # OUT/seed_N/, then prints one table: position RMSE and mean NEES by stage, GO count, unsafe GO
 # and the largest true lateral error at GO, and the means over the seeds.
@@ -16,6 +19,7 @@ out=out/seeds
 commands="run"
 detector=contrast
 reuse=0
+config=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --scenario) scenario="$2"; shift 2 ;;
@@ -24,6 +28,8 @@ while [[ $# -gt 0 ]]; do
     --smooth) commands="run smooth"; shift ;;
     --detector) detector="$2"; shift 2 ;;
     --reuse-datasets) reuse=1; shift ;;
+    --config) config=(--config "$2"); shift 2 ;;
+    --commands) commands="$2"; shift 2 ;;
     *) echo "evaluate_seeds.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -33,14 +39,14 @@ mkdir -p "$out"
 for seed in $seeds; do
   dir="$out/seed_$seed"
   if [[ $reuse == 1 && -f "$dir/dataset/groundtruth.tum" ]]; then
-    for command in run smooth; do rm -rf "${dir:?}/$command"; done
+    for command in $commands; do rm -rf "${dir:?}/$command"; done
   else
     rm -rf "$dir"   # this script's own folder from an earlier call
     "$bin" simulate --scenario "$scenario" --seed "$seed" --out "$dir/dataset" --quiet
   fi
   for command in $commands; do
     "$bin" "$command" --dataset "$dir/dataset" --out "$dir/$command" --detector "$detector" \
-      --quiet > /dev/null
+      "${config[@]}" --quiet > /dev/null
     "$bin" evaluate --dataset "$dir/dataset" --estimate "$dir/$command/trajectory.tum" \
       --covariance "$dir/$command/covariance.csv" --decisions "$dir/$command/decisions.csv" \
       --json > "$dir/$command/evaluation.json"

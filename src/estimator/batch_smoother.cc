@@ -260,6 +260,13 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   }
   std::stable_sort(result.rejections.begin(), result.rejections.end(),
                    [](const Rejection& a, const Rejection& b) { return a.t_ns < b.t_ns; });
+  {
+    std::vector<VisionResidual> all_vision;
+    for (const auto& s : states) all_vision.insert(all_vision.end(), s->vision.begin(), s->vision.end());
+    const double interval_s = MedianStateInterval(states);
+    result.vision_errors = MeasureVisionErrors(
+        problem, all_vision, static_cast<int64_t>(1.5e9 * interval_s));
+  }
   result.final_cost = summary.final_cost;
   result.iterations = static_cast<int>(summary.iterations.size());
   result.converged = summary.termination_type == ceres::CONVERGENCE;

@@ -130,7 +130,7 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
         problem, std::move(factor), *mono_shift, WeightedHuber(options.huber_sigmas, weights.mono),
         state);
     added.push_back({id, true, obs.light_id, weights.mono, frame.t_ns + frame.mono_dt_ns,
-                     rig.mono->name});
+                     rig.mono->name, std::sqrt(covariance(0, 0))});
   }
   // The body pose the stereo covariances are evaluated at, once per frame.
   std::optional<Pose3> T_B_D_predicted;
@@ -151,15 +151,15 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
         covariance = *predicted;
       }
     }
+    const double scale = Factor(options.stereo_variance_factor, obs.light_id) * stereo_scale;
     const ceres::ResidualBlockId id = AddResidual<StereoPointFactor, kStereoPointResidualSize>(
         problem,
-        std::make_unique<StereoPointFactor>(
-            obs.p_S,
-            Factor(options.stereo_variance_factor, obs.light_id) * stereo_scale * covariance,
-            rig.stereo_left->T_B_C, light->p_D),
+        std::make_unique<StereoPointFactor>(obs.p_S, scale * covariance, rig.stereo_left->T_B_C,
+                                            light->p_D),
         *stereo_shift, WeightedHuber(options.huber_sigmas, weights.stereo), state);
-    added.push_back({id, false, obs.light_id, weights.stereo,
-                     frame.t_ns + frame.stereo_dt_ns, rig.stereo_left->name});
+    added.push_back({id, false, obs.light_id, weights.stereo, frame.t_ns + frame.stereo_dt_ns,
+                     rig.stereo_left->name,
+                     std::sqrt(scale) * rig.stereo_left->pixel_noise_px});
   }
   return added;
 }

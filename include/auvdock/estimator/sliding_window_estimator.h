@@ -101,8 +101,8 @@ struct EstimatorOptions {
   // Batch smoother only (estimator/batch_smoother.h): the slowly varying part of the detection
   // errors, per pixel coordinate (1-sigma, px) and its correlation time (s); either 0 = white
   // errors only. The sliding window ignores them. README, "Vision noise".
-  double smoother_vision_floor_px = 0.075;
-  double smoother_vision_correlation_time_s = 2.0;
+  double smoother_vision_floor_px = 0.10;
+  double smoother_vision_correlation_time_s = 5.0;
   // The same model for the sliding window, whose marginalisation prior carries the past frames'
   // information as the smoother's batch does: N_c s^2 added to every pixel coordinate's variance,
   // N_c from the interval since the previous frame (0.07 px, 1 s at 10 Hz: N_c = 20, +0.1 px^2).

@@ -73,6 +73,10 @@ struct VisionResidual {
   double weight = 1.0;  // the stage weight on its information
   int64_t t_ns = 0;     // the image's time
   std::string sensor;   // the camera's name (the mono camera, or the stereo pair's left)
+  // The pixel sigma the residual is whitened with (px, variance factor and correlated variance
+  // included): whitened residual x pixel_sigma_px is the error in pixel-equivalent units (the
+  // pixel error for mono; for stereo the point error in the units of the pair's pixel noise).
+  double pixel_sigma_px = 1.0;
 };
 
 // What the factors need to know about the rig and the dock. Any camera may be null (without
