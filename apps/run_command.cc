@@ -72,6 +72,7 @@ void Run(const RunOptions& options) {
       if (out) {
         const GoNoGoDecision decision = go_no_go.Decide(*out);
         counters.go += decision.go;
+        counters.symmetry_unresolved += out->symmetry_unresolved;
         writer.Write(*out, decision);
       } else {
         writer.WriteNoEstimate(frame->t_ns, go_no_go.NoEstimate(
@@ -102,6 +103,7 @@ void Run(const RunOptions& options) {
   for (const auto& [reason, count] : source.no_vision_reasons()) {
     std::printf("  no vision: %d frames: %s\n", count, reason.c_str());
   }
+  PrintSymmetryUnresolved("run", counters.symmetry_unresolved);
   std::printf("  per frame: decode %.2f ms, front-end %.2f ms, back-end %.2f ms\n",
               1e3 * source.decode_s() / counters.frames,
               1e3 * source.frontend_s() / counters.frames, 1e3 * counters.backend_s / counters.frames);

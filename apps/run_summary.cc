@@ -1,6 +1,7 @@
 #include "apps/run_summary.h"
 
 #include <algorithm>
+#include <cstdio>
 
 namespace auvdock::cli {
 
@@ -16,6 +17,7 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
   summary["frames_in_dataset"] = source.num_frames();
   summary["estimates"] = stats.frames_with_output;
   summary["go_decisions"] = counters.go;
+  summary["symmetry_unresolved_estimates"] = counters.symmetry_unresolved;
   summary["rejections"] = counters.rejections;
   summary["unreadable_images"] = source.unreadable_images();
   summary["imu_samples"] = stats.imu_samples;
@@ -53,6 +55,14 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
   log.insert(log.end(), stats.log.begin(), stats.log.end());
   summary["log"] = log;
   return summary;
+}
+
+void PrintSymmetryUnresolved(const char* command, int count) {
+  if (count == 0) return;
+  std::printf("  %s: %d estimates are known only up to the dock's symmetry: nothing told its "
+              "rival poses apart (give dock.yaml approach_direction_D, or acoustic fixes); they "
+              "are NO-GO\n",
+              command, count);
 }
 
 }  // namespace auvdock::cli

@@ -18,10 +18,14 @@ struct RunCounters {
   int frames = 0;
   int go = 0;
   int rejections = 0;  // rows written to rejections.csv
+  int symmetry_unresolved = 0;  // estimates known only up to the dock's symmetry
   double backend_s = 0.0;
   double total_s = 0.0;
   bool interrupted = false;
 };
+
+// One line on stdout when some estimates are known only up to the dock's symmetry.
+void PrintSymmetryUnresolved(const char* command, int count);
 
 nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorStats& stats,
                               const std::vector<std::string>& skipped_rows,

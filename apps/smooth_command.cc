@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <set>
 
 #include "apps/commands.h"
 #include "apps/estimate_writer.h"
@@ -49,6 +50,7 @@ void Smooth(const SmoothOptions& options) {
   const CancellationToken cancel = InstallSignalCancellation();
   RunCounters counters;
   std::vector<VisionFrame> frames;
+  std::set<int64_t> symmetry_unresolved_t_ns;  // the window's outputs up to the symmetry
   SensorFeed feed(dataset, &estimator);
   // The pipeline's prediction at a frame: the estimate propagated with the IMU up to the frame
   // (causal: samples at or before the frame time).
@@ -60,7 +62,8 @@ void Smooth(const SmoothOptions& options) {
     cancel.ThrowIfCancelled();
     const auto t0 = Clock::now();
     feed.FeedAllUpTo(frame->last_t_ns());
-    estimator.AddVisionFrame(*frame);
+    const std::optional<EstimatorOutput> out = estimator.AddVisionFrame(*frame);
+    if (out && out->symmetry_unresolved) symmetry_unresolved_t_ns.insert(out->t_ns);
     // The warm start's own rejections are not this command's: the batch gates again below.
     estimator.TakeRejections();
     counters.backend_s += Seconds(Clock::now() - t0);
@@ -92,7 +95,10 @@ void Smooth(const SmoothOptions& options) {
   size_t next_output = 0;
   for (const VisionFrame& frame : frames) {
     if (next_output < result.outputs.size() && result.outputs[next_output].t_ns == frame.t_ns) {
-      const EstimatorOutput& out = result.outputs[next_output++];
+      EstimatorOutput out = result.outputs[next_output++];
+      // The batch keeps the window's choice among a symmetric dock's rival poses.
+      out.symmetry_unresolved = symmetry_unresolved_t_ns.count(out.t_ns) > 0;
+      counters.symmetry_unresolved += out.symmetry_unresolved;
       const GoNoGoDecision decision = go_no_go.Decide(out);
       counters.go += decision.go;
       writer.Write(out, decision);
@@ -132,6 +138,7 @@ void Smooth(const SmoothOptions& options) {
   for (const auto& [reason, count] : source.no_vision_reasons()) {
     std::printf("  no vision: %d frames: %s\n", count, reason.c_str());
   }
+  PrintSymmetryUnresolved("smooth", counters.symmetry_unresolved);
 }
 
 }  // namespace

@@ -88,6 +88,12 @@ VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind d
                                      int64_t sync_tolerance_ns)
     : pipeline_(dataset.calibration, RequireDock(dataset), PipelineOptions(detector)) {
   cameras_ = {pipeline_.left_camera(), pipeline_.right_camera(), pipeline_.mono_camera()};
+  if (dataset.calibration.acoustic) {
+    fixes_ = dataset.acoustic;
+    std::stable_sort(fixes_.begin(), fixes_.end(),
+                     [](const AcousticFix& a, const AcousticFix& b) { return a.t_ns < b.t_ns; });
+    fix_T_B_S_ = dataset.calibration.acoustic->T_B_S;
+  }
   std::array<std::vector<const CameraFrame*>, 3> by_camera;
   for (int c = 0; c < 3; ++c) {
     if (!cameras_[c] || !dataset.camera_frames.count(cameras_[c]->name)) continue;
@@ -136,6 +142,10 @@ std::optional<VisionFrame> VisionFrameSource::Next(const Predictor& predict) {
     if (group.images[c]) images[c] = ReadImage(*group.images[c], *cameras_[c], &unreadable_images_);
   }
   const auto t1 = Clock::now();
+  for (; next_fix_ < fixes_.size() && fixes_[next_fix_].t_ns <= t; ++next_fix_) {
+    const AcousticFix& fix = fixes_[next_fix_];
+    pipeline_.SetPositionFix(fix.t_ns, fix.p_D, fix.sigma_m, fix_T_B_S_);
+  }
   const BaselineFrame frame =
       pipeline_.Process(t, images[0], images[1], images[2], predict ? predict(t) : std::nullopt);
   VisionFrame vision = MakeVisionFrame(frame, cameras_[0], cameras_[1], cameras_[2]);

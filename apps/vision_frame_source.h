@@ -43,7 +43,8 @@ class VisionFrameSource {
   using Predictor = std::function<std::optional<Pose3>(int64_t t_ns)>;
 
   // The next frame, or nothing at the end. predict (optional) lets the pipeline track and
-  // resolve a symmetric dock when its own last pose is too old.
+  // resolve a symmetric dock when its own last pose is too old; so do the dataset's acoustic
+  // fixes (each from its own time on: causal).
   std::optional<VisionFrame> Next(const Predictor& predict = {});
 
   const std::vector<std::string>& warnings() const { return pipeline_.warnings(); }
@@ -74,6 +75,11 @@ class VisionFrameSource {
   int unreadable_images_ = 0;
   bool warned_unsynchronised_pair_ = false;
   std::map<std::string, int> no_vision_reasons_;
+  // The acoustic fixes, in time order: each is handed to the pipeline (a symmetric dock's poses
+  // told apart) by the first frame at or after its time.
+  std::vector<AcousticFix> fixes_;
+  size_t next_fix_ = 0;
+  Pose3 fix_T_B_S_;
 };
 
 }  // namespace auvdock::cli

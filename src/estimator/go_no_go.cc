@@ -38,6 +38,10 @@ GoNoGoDecision GoNoGo::Decide(const EstimatorOutput& output) {
   if (!output.covariance_ok || !output.covariance.allFinite()) {
     return {false, "covariance unavailable (rank-deficient or not computed)"};
   }
+  if (output.symmetry_unresolved) {
+    return {false, "pose known only up to the dock's symmetry (nothing told its rival poses "
+                   "apart: give dock.yaml approach_direction_D or acoustic fixes)"};
+  }
   if (output.seconds_since_vision < 0.0) return {false, "no vision yet"};
   const bool dvl_aided =
       output.seconds_since_dvl >= 0.0 && output.seconds_since_dvl <= options_.max_dvl_age_s;

@@ -81,6 +81,7 @@ void SlidingWindowEstimator::Reset(const std::string& reason) {
     history_.push_back(record);
   }
   window_.clear();
+  symmetry_unresolved_ = false;
   dvl_rate_test_.Reset();
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -112,6 +113,7 @@ void SlidingWindowEstimator::AddImu(const ImuSample& sample) {
 
 bool SlidingWindowEstimator::Initialize(const VisionFrame& frame) {
   if (!frame.T_D_B_initial) return false;
+  symmetry_unresolved_ = frame.symmetry_unresolved;
   auto state = std::make_unique<State>();
   state->t_ns = frame.t_ns;
   PoseToBlock(*frame.T_D_B_initial, state->pose);
@@ -307,6 +309,7 @@ void SlidingWindowEstimator::MarginalizeOldest() {
 
 EstimatorOutput SlidingWindowEstimator::Output(const State& state) {
   EstimatorOutput out;
+  out.symmetry_unresolved = symmetry_unresolved_;
   out.t_ns = state.t_ns;
   out.T_D_B = PoseFromBlock(state.pose);
   out.v_D = Eigen::Map<const Eigen::Vector3d>(state.velocity);

@@ -32,6 +32,7 @@ VisionFrame MakeVisionFrame(const BaselineFrame& frame, const CameraCalibration*
   VisionFrame out;
   out.t_ns = frame.t_ns;
   out.T_D_B_initial = frame.T_D_B;
+  out.symmetry_unresolved = frame.symmetry_unresolved;
   if (mono) {
     for (const auto& [id, i] : IdentifiedLights(frame.mono)) {
       MonoLightObservation obs;

@@ -1,6 +1,7 @@
 #include "auvdock/vision/paper_baseline_pipeline.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -78,11 +79,20 @@ std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& ca
     if (dock_.approach_direction_D.norm() > 0.0) {
       hint.approach_direction_D = dock_.approach_direction_D;
     }
+    if (fix_ && t_ns >= fix_->t_ns) {
+      const double age_s = 1e-9 * static_cast<double>(t_ns - fix_->t_ns);
+      if (age_s <= options_.fix_max_age_s) {
+        hint.fix_p_D = fix_->p_D;
+        hint.fix_sigma_m = std::hypot(fix_->sigma_m, options_.fix_max_speed_mps * age_s);
+        hint.T_C_S = camera.T_B_C.Inverse() * fix_->T_B_S;
+      }
+    }
     RansacMatchResult result =
         MatchRansac(obs->detections, dock_, camera.intrinsics, ransac, rng_, hint);
     T_C_D = result.T_C_D;
     match = result;
     obs->symmetry = result.symmetry;
+    obs->symmetry_unresolved = result.symmetry_unresolved;
   }
   if (match.status != MatchStatus::kOk && predicted_T_C_D) {
     const MatchResult tracked = MatchByPrediction(obs->detections, dock_, camera.intrinsics,
@@ -328,6 +338,26 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
     if (frame.reason.empty()) frame.reason = "no camera sees enough identified lights";
   }
   if (frame.T_D_B) {
+    // Symmetry provenance of the track: an unresolved choice in any camera taints it; a choice
+    // by evidence of its own (gravity, a fix, the approach side: not the prediction, which
+    // follows the track) clears it; tracking and the prediction keep it as it was.
+    bool unresolved = false, resolved = false;
+    for (const CameraObservation* obs : {&frame.left, &frame.right, &frame.mono}) {
+      if (obs->status != MatchStatus::kOk || obs->symmetry.empty() || obs->tracked) continue;
+      if (obs->symmetry_unresolved) {
+        unresolved = true;
+      } else if (obs->symmetry.find("chosen by the prediction") == std::string::npos) {
+        resolved = true;
+      }
+    }
+    const bool continues = last_T_D_B_ && t_ns - last_t_ns_ <= static_cast<int64_t>(
+                                              1e9 * options_.tracking_max_age_s);
+    if (unresolved) {
+      track_symmetry_unresolved_ = true;
+    } else if (resolved || (!continues && !predicted_T_D_B)) {
+      track_symmetry_unresolved_ = false;
+    }
+    frame.symmetry_unresolved = track_symmetry_unresolved_;
     last_T_D_B_ = frame.T_D_B;
     last_t_ns_ = t_ns;
   }
@@ -353,6 +383,12 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
   }
   NoteIdentified(frame);
   return frame;
+}
+
+void PaperBaselinePipeline::SetPositionFix(int64_t t_ns, const Eigen::Vector3d& p_D,
+                                           double sigma_m, const Pose3& T_B_S) {
+  if (!p_D.allFinite() || !std::isfinite(sigma_m) || !(sigma_m > 0.0)) return;
+  fix_ = PositionFix{t_ns, p_D, sigma_m, T_B_S};
 }
 
 int PaperBaselinePipeline::WeighEstimateLabels(const CameraCalibration& camera, const Pose3& T_C_D,

@@ -559,7 +559,8 @@ constexpr double kCollinearTolerance = 0.05;
 // copies, and in *note how it was chosen.
 size_t ChooseSymmetricCopy(const std::vector<Pose3>& copies, const DockModel& dock,
                            const std::vector<DockSymmetry>& symmetries, const SymmetryHint& hint,
-                           std::string* note) {
+                           std::string* note, bool* unresolved) {
+  *unresolved = false;
   constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
   // Angular error (rad) of every copy against the hint; the smallest wins when the next is at
   // least twice as far (a prediction or gravity a few degrees off, copies tens of degrees apart).
@@ -591,6 +592,29 @@ size_t ChooseSymmetricCopy(const std::vector<Pose3>& copies, const DockModel& do
     }
     if (auto k = pick(error, "gravity")) return *k;
   }
+  if (hint.fix_p_D && hint.fix_sigma_m > 0.0) {
+    // Distances (m) of the fixed point, placed by each copy, from the fix.
+    std::vector<double> distance;
+    for (const Pose3& c : copies) distance.push_back((c.Inverse() * hint.T_C_S.p - *hint.fix_p_D).norm());
+    const double nearest = *std::min_element(distance.begin(), distance.end());
+    const double gate = hint.fix_gate_sigmas * hint.fix_sigma_m +
+                        hint.fix_range_fraction * copies[0].p.norm();
+    if (nearest <= gate) {
+      std::vector<size_t> order(distance.size());
+      for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+      std::sort(order.begin(), order.end(),
+                [&](size_t a, size_t b) { return distance[a] < distance[b]; });
+      // The next copy must be twice as far and outside the gate itself.
+      if (distance[order[1]] >= 2.0 * distance[order[0]] && distance[order[1]] > gate) {
+        std::ostringstream s;
+        s.precision(3);
+        s << "chosen by the acoustic fix (" << distance[order[0]] << " m off, next "
+          << distance[order[1]] << " m, sigma " << hint.fix_sigma_m << " m)";
+        *note = s.str();
+        return order[0];
+      }
+    }
+  }
   if (hint.approach_direction_D && hint.approach_direction_D->norm() > 0.0) {
     // The copies' camera centres differ by turns about the symmetry axis (through the lights'
     // centroid): compare their bearings about that axis with the approach direction's.
@@ -607,8 +631,9 @@ size_t ChooseSymmetricCopy(const std::vector<Pose3>& copies, const DockModel& do
     }
     if (auto k = pick(error, "the approach side")) return *k;
   }
-  *note = "unresolved: no prediction, gravity or approach side tells the copies apart; the "
-          "labels are defined up to the symmetry (the rival poses are listed)";
+  *note = "unresolved: no prediction, gravity, acoustic fix or approach side tells the copies "
+          "apart; the labels are defined up to the symmetry (the rival poses are listed)";
+  *unresolved = true;
   return 0;
 }
 
@@ -888,7 +913,8 @@ RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, con
       const Eigen::Matrix3d R = best_pose.R * s.R.transpose();
       copies.emplace_back(Eigen::Quaterniond(R), best_pose.t - R * s.t);
     }
-    const size_t chosen = ChooseSymmetricCopy(copies, dock, symmetries, hint, &result.symmetry);
+    const size_t chosen = ChooseSymmetricCopy(copies, dock, symmetries, hint, &result.symmetry,
+                                             &result.symmetry_unresolved);
     result.symmetry = DescribeDockSymmetries(symmetries) + " symmetric dock: " + result.symmetry;
     T_C_D = copies[chosen];
     for (size_t k = 0; k < copies.size(); ++k) {

@@ -23,6 +23,16 @@ TEST(GoNoGoTest, PreciseHealthyEstimateIsGo) {
   EXPECT_TRUE(d.go) << d.reason;
 }
 
+TEST(GoNoGoTest, APoseKnownOnlyUpToTheDocksSymmetryIsNoGoWhateverItsCovariance) {
+  GoNoGo decide;
+  EstimatorOutput out = PreciseOutput();
+  out.symmetry_unresolved = true;
+  const GoNoGoDecision d = decide.Decide(out);
+  EXPECT_FALSE(d.go);
+  EXPECT_THAT(d.reason, HasSubstr("up to the dock's symmetry"));
+  EXPECT_EQ(d.reason.find(','), std::string::npos);  // a CSV field
+}
+
 TEST(GoNoGoTest, LateralThreeSigmaUsesTheMajorAxisOfTheHorizontalCovariance) {
   GoNoGoOptions options;
   options.allowed_lateral_error_m = 0.10;

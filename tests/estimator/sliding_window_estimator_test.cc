@@ -168,6 +168,39 @@ TEST(SlidingWindowEstimatorTest, AnImuGapResetsAndTheNextPerFramePoseRestarts) {
   EXPECT_GT(outputs_after_gap, 10);
 }
 
+// A window started from a pose chosen among a symmetric dock's rivals by nothing keeps saying
+// so in every output until a reset, whatever the later frames say (they follow its choice);
+// the window restarted after the reset from a resolved pose does not.
+TEST(SlidingWindowEstimatorTest, AnUnresolvedSymmetricStartIsFlaggedUntilAReset) {
+  test::SyntheticRun run = MakeRun(4);
+  run.frames[0].symmetry_unresolved = true;
+  SlidingWindowEstimator estimator(run.calibration, run.dock);
+  size_t next_imu = 0;
+  int flagged_before = 0, outputs_before = 0, flagged_after = 0, outputs_after = 0;
+  for (size_t k = 0; k < 40; ++k) {
+    const VisionFrame& frame = run.frames[k];
+    while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= frame.t_ns) {
+      const ImuSample& s = run.imu[next_imu++];
+      if (k >= 20 && k < 25) continue;  // an IMU gap: a reset
+      estimator.AddImu(s);
+    }
+    const auto out = estimator.AddVisionFrame(frame);
+    if (!out) continue;
+    if (k < 20) {
+      ++outputs_before;
+      flagged_before += out->symmetry_unresolved;
+    } else if (k >= 26) {
+      ++outputs_after;
+      flagged_after += out->symmetry_unresolved;
+    }
+  }
+  EXPECT_GE(estimator.stats().resets, 1);
+  EXPECT_GT(outputs_before, 15);
+  EXPECT_EQ(flagged_before, outputs_before);
+  EXPECT_GT(outputs_after, 10);
+  EXPECT_EQ(flagged_after, 0);
+}
+
 TEST(SlidingWindowEstimatorTest, CarriesOnOnTheImuWithoutVisionAndTheCovarianceGrows) {
   test::SyntheticRun run = MakeRun(5);
   SlidingWindowEstimator estimator(run.calibration, run.dock);

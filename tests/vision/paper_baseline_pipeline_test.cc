@@ -11,6 +11,7 @@
 
 #include "auvdock/sim/docking_trajectory.h"
 #include "auvdock/sim/scenario.h"
+#include "tests/testing/dock_views.h"
 #include "tests/testing/test_scenarios.h"
 
 namespace auvdock {
@@ -187,6 +188,47 @@ TEST(PaperBaselinePipelineTest, MonoPoseOfAPlanarTwinIsChosenByThePrediction) {
   const Pose3 T_D_B = trajectory.At(27.5).T_D_B;
   EXPECT_LT((frame.T_D_B_mono->p - T_D_B.p).norm(), 0.05);
   EXPECT_LT(RotationAngleBetween(frame.T_D_B_mono->q, T_D_B.q), 0.02);
+}
+
+// The ring of 8 (turns of 90 degrees about gravity) without an approach side: the first pose is
+// one of four rivals chosen by nothing, and every frame that tracks it stays flagged; an
+// acoustic fix of the transponder at the first frame picks the true copy.
+TEST(PaperBaselinePipelineTest, AnUnresolvedSymmetricChoiceIsFlaggedWhileTrackedAndAFixResolvesIt) {
+  const Scenario scenario = test::DefaultScenario();
+  const Calibration calibration = MakeCalibration(scenario);
+  const DockingTrajectory trajectory(scenario.trajectory);
+  DockModel ring = test::LoadDock("ring_8.yaml");
+  ring.approach_direction_D = Eigen::Vector3d::Zero();
+  const auto frames = [&](PaperBaselinePipeline& pipeline) {
+    std::vector<BaselineFrame> out;
+    for (const double t : {20.0, 20.1, 20.2}) {
+      out.push_back(pipeline.ProcessDetections(
+          static_cast<int64_t>(t * 1e9), std::nullopt, std::nullopt,
+          ProjectLights(*pipeline.mono_camera(), ring, trajectory.At(t).T_D_B)));
+    }
+    return out;
+  };
+  PaperBaselinePipeline alone(calibration, ring);
+  const std::vector<BaselineFrame> unresolved = frames(alone);
+  ASSERT_TRUE(unresolved[0].T_D_B.has_value()) << unresolved[0].reason;
+  EXPECT_TRUE(unresolved[0].mono.symmetry_unresolved) << unresolved[0].mono.symmetry;
+  for (const BaselineFrame& f : unresolved) {
+    ASSERT_TRUE(f.T_D_B.has_value()) << f.reason;
+    EXPECT_TRUE(f.symmetry_unresolved) << f.mono.symmetry;
+  }
+
+  PaperBaselinePipeline with_fix(calibration, ring);
+  const Pose3 T_B_S(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.0, 0.0, -0.2));
+  with_fix.SetPositionFix(20'000'000'000, trajectory.At(20.0).T_D_B * T_B_S.p, 0.05, T_B_S);
+  const std::vector<BaselineFrame> resolved = frames(with_fix);
+  for (size_t k = 0; k < resolved.size(); ++k) {
+    ASSERT_TRUE(resolved[k].T_D_B.has_value()) << resolved[k].reason;
+    EXPECT_FALSE(resolved[k].symmetry_unresolved) << resolved[k].mono.symmetry;
+    const Pose3 truth = trajectory.At(20.0 + 0.1 * k).T_D_B;
+    EXPECT_LT((resolved[k].T_D_B->p - truth.p).norm(), 0.05);
+  }
+  EXPECT_NE(resolved[0].mono.symmetry.find("acoustic fix"), std::string::npos)
+      << resolved[0].mono.symmetry;
 }
 
 // The end of a landing: the mono camera sees two lights, too few for any pose. With a fresh

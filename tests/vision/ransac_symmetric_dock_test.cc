@@ -1,6 +1,7 @@
 // MatchRansac on symmetric docks (ring of 8: 4-fold; corners + raised centre: 2-fold): a pose is
 // given in every view (not "ambiguous"), the labels are right up to the symmetry, every rival
 // pose is listed, and a hint (prediction, gravity, approach side) picks the true copy.
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -134,6 +135,7 @@ TEST(RansacSymmetricDock, GravityCannotResolveAFlatDockTurnedAboutTheVertical) {
     if (r.status == MatchStatus::kOk) {
       ++ok;
       unresolved += r.symmetry.find("unresolved") != std::string::npos;
+      EXPECT_EQ(r.symmetry_unresolved, r.symmetry.find("unresolved") != std::string::npos);
     }
     // The camera centre's side of the dock, as an approach direction (horizontal, in D).
     const Eigen::Vector3d centre_D = T_C_D.Inverse().p;
@@ -151,6 +153,50 @@ TEST(RansacSymmetricDock, GravityCannotResolveAFlatDockTurnedAboutTheVertical) {
   EXPECT_EQ(unresolved, ok);
   EXPECT_GE(ok_by_side, 10);
   EXPECT_EQ(right_by_side, ok_by_side);
+}
+
+TEST(RansacSymmetricDock, AnAcousticFixPicksTheTrueCopyAndAnOutlierTellsNothing) {
+  // The ring flat on the deck (its turns are about gravity): a USBL fix of a transponder 0.3 m
+  // behind the camera tells the copies apart; a fix 5 m off fits no copy and decides nothing.
+  const DockModel dock = test::LoadDock("ring_8.yaml");
+  const auto symmetries = FindDockSymmetries(dock);
+  const PinholeRadtanCamera camera = test::DefaultMonoCamera();
+  std::mt19937_64 rng(13);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  const Pose3 T_C_S(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.1, -0.2, -0.3));
+  int ok = 0, right = 0, by_fix = 0, outlier_ok = 0, outlier_unresolved = 0;
+  for (int v = 0; v < 40; ++v) {
+    const Pose3 T_C_D = test::RandomView(dock, camera, 25 * kDeg, rng);
+    const test::View view =
+        test::MakeView(dock, camera, T_C_D, test::AllLightIds(dock), 0, 0.3, rng);
+    SymmetryHint hint;
+    hint.gravity_C = T_C_D.R() * dock.gravity_D;
+    hint.T_C_S = T_C_S;
+    hint.fix_sigma_m = 0.05;
+    const Eigen::Vector3d transponder_D = T_C_D.Inverse() * T_C_S.p;
+    // Within 0.3 m of the ring's axis the copies put the transponder within 0.42 m of each
+    // other: a 5 cm fix no longer tells them apart with certainty (it may, or stay unresolved).
+    if (std::hypot(transponder_D.x(), transponder_D.y()) < 0.3) continue;
+    hint.fix_p_D = transponder_D + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    const RansacMatchResult r = MatchRansac(view.detections, dock, camera, {}, rng, hint);
+    if (r.status == MatchStatus::kOk) {
+      ++ok;
+      right += LabelsUpToSymmetry(r, view, dock, symmetries) == 0;
+      by_fix += r.symmetry.find("acoustic fix") != std::string::npos;
+      EXPECT_FALSE(r.symmetry_unresolved) << r.symmetry << " d=" << std::hypot(transponder_D.x(), transponder_D.y());
+    }
+    hint.fix_p_D = *hint.fix_p_D + Eigen::Vector3d(5.0, 0.0, 0.0);
+    const RansacMatchResult o = MatchRansac(view.detections, dock, camera, {}, rng, hint);
+    if (o.status != MatchStatus::kOk) continue;
+    ++outlier_ok;
+    outlier_unresolved += o.symmetry_unresolved;
+    EXPECT_NE(o.symmetry.find("unresolved"), std::string::npos) << o.symmetry;
+  }
+  EXPECT_GE(ok, 20);
+  EXPECT_EQ(right, ok);
+  EXPECT_EQ(by_fix, ok);
+  EXPECT_EQ(outlier_ok, ok);
+  EXPECT_EQ(outlier_unresolved, outlier_ok);
 }
 
 TEST(RansacSymmetricDock, TDockIsUnaffected) {

@@ -4,6 +4,9 @@
 // Checks, in order (thresholds in GoNoGoOptions):
 //   1. an estimate exists and its covariance is available (a rank-deficient or failed
 //      covariance is NO-GO: the estimator cannot say how wrong it is);
+//   1b. a pose that the lights fix only up to a symmetric dock's symmetry, with nothing that
+//      told the rival poses apart (EstimatorOutput::symmetry_unresolved): the covariance
+//      describes one of the rivals, which may be turned by the symmetry from the true pose;
 //   2. recent vision: the newest frame with a used vision residual is at most
 //      max_vision_age_s old (on the IMU alone the error grows without a bound the vehicle
 //      should trust, whatever the covariance says). With the DVL fused the horizontal error

@@ -143,6 +143,10 @@ struct EstimatorOutput {
   int n_gated = 0;                              // vision residuals rejected in this frame
   double seconds_since_vision = -1.0;           // age of the newest used vision (-1: never)
   double seconds_since_dvl = -1.0;              // of the newest used DVL sample (-1: never)
+  // The window started from a pose chosen among a symmetric dock's rival poses by nothing
+  // (VisionFrame::symmetry_unresolved), and the track has followed that choice since: the pose
+  // may be any of the rivals (the dock's symmetries applied to it). Until a reset.
+  bool symmetry_unresolved = false;
 };
 
 // Why a frame produced no estimate, or what it skipped.
@@ -255,6 +259,7 @@ class SlidingWindowEstimator {
   int64_t last_dvl_sample_t_ns_ = INT64_MIN;
   int64_t last_frame_t_ns_ = INT64_MIN;
   int64_t last_vision_t_ns_ = INT64_MIN;
+  bool symmetry_unresolved_ = false;  // of the window's first pose (EstimatorOutput)
   int64_t last_dvl_t_ns_ = INT64_MIN;
   EstimatorStats stats_;
   // Per light id: the adaptive variance factors of its mono pixels and its stereo points.

@@ -43,6 +43,9 @@ struct VisionFrame {
   std::optional<Pose3> T_D_B_initial;
   int64_t mono_dt_ns = 0;    // mono image time - t_ns
   int64_t stereo_dt_ns = 0;  // stereo pair time - t_ns
+  // The identification chose among a symmetric dock's rival poses by nothing (no prediction,
+  // gravity, fix or approach side): the lights fix the pose only up to the dock's symmetry.
+  bool symmetry_unresolved = false;
 
   bool empty() const { return mono.empty() && stereo.empty(); }
   // The time of the frame's latest image: it is complete (and may be used) from then on.

@@ -122,6 +122,10 @@ struct PaperBaselineOptions {
   // Step 7's labels: each detection's centroid covariance grows by (this x its radius)^2.
   double estimate_size_sigma_fraction = 0.1;
   uint64_t seed = 1;          // the matcher's random subsets (deterministic)
+  // A position fix (SetPositionFix) chooses among a symmetric dock's poses up to this age; its
+  // sigma grows by max_speed_mps per second of age.
+  double fix_max_age_s = 5.0;
+  double fix_max_speed_mps = 1.0;
 };
 
 // What one camera saw and how its lights were identified.
@@ -131,6 +135,7 @@ struct CameraObservation {
   MatchStatus status = MatchStatus::kFailed;
   std::string reason;
   std::string symmetry;  // how a symmetric dock's pose was chosen (empty: not symmetric)
+  bool symmetry_unresolved = false;  // ... by nothing: the pose is one of the rival poses
   bool tracked = false;  // identified by prediction (tracking) rather than from scratch
   int guided = 0;        // detections added by the second look (steps 6, 7), at the end
   int by_estimate = 0;   // lights identified by the estimate alone (step 7)
@@ -149,6 +154,9 @@ struct BaselineFrame {
   double stereo_weight = 0.0;
   std::string reason;  // why there is no pose
   bool by_estimate = false;  // step 7 ran: cameras that identified nothing used the estimate
+  // The pose is one of a symmetric dock's rival poses, chosen by nothing: in this frame, or in
+  // an earlier one that the track (the prediction) has followed since.
+  bool symmetry_unresolved = false;
 };
 
 class PaperBaselinePipeline {
@@ -176,6 +184,12 @@ class PaperBaselinePipeline {
   const CameraCalibration* left_camera() const { return left_; }
   const CameraCalibration* right_camera() const { return right_; }
   const CameraCalibration* mono_camera() const { return mono_; }
+  // A position fix of a point of the vehicle (frame T_B_S; an acoustic USBL fix, 1-sigma
+  // sigma_m per axis) at t_ns, used by the frames after it to choose among a symmetric dock's
+  // poses (SymmetryHint::fix_p_D).
+  void SetPositionFix(int64_t t_ns, const Eigen::Vector3d& p_D, double sigma_m,
+                      const Pose3& T_B_S);
+
   // What of the rig the pipeline cannot use, and why (a lone stereo camera), for the log.
   const std::vector<std::string>& warnings() const { return warnings_; }
 
@@ -209,6 +223,14 @@ class PaperBaselinePipeline {
   std::mt19937_64 rng_;
   std::optional<Pose3> last_T_D_B_;  // the previous reported pose, for tracking
   std::optional<Pose3> external_T_D_B_;  // this frame's prediction from elsewhere, if any
+  struct PositionFix {
+    int64_t t_ns = 0;
+    Eigen::Vector3d p_D;
+    double sigma_m = 0.0;
+    Pose3 T_B_S;
+  };
+  std::optional<PositionFix> fix_;
+  bool track_symmetry_unresolved_ = false;  // the reported track follows an unresolved choice
   int64_t last_t_ns_ = 0;
   std::optional<int64_t> last_identified_t_ns_;  // the last frame with an identified light
   const CameraCalibration* left_ = nullptr;

@@ -127,7 +127,11 @@ struct RansacMatcherOptions {
 // What is known besides the pixels, to choose among a symmetric dock's equally good poses
 // (T_C_D S^-1 for every symmetry S): in this order, the copy nearest in rotation to a predicted
 // pose (tracking), the copy whose gravity direction R_C_D g_D is nearest to the measured one
-// (gravity_C: from the IMU's attitude, any length), the copy whose camera centre's bearing about
+// (gravity_C: from the IMU's attitude, any length), the copy that puts a point of the vehicle
+// nearest to its position fix (fix_p_D, an acoustic USBL fix of the transponder at p_C = the
+// translation of T_C_S, within fix_gate_sigmas fix_sigma_m + fix_range_fraction x the camera's
+// distance from the dock of it -- the fix's error and the pose's own, which grows with range: a
+// fix that fits no copy is an outlier and tells nothing), the copy whose camera centre's bearing about
 // the symmetry axis is nearest to that of the approach direction (approach_direction_D, D frame:
 // where the vehicle comes from, seen from the dock). A hint decides only when
 // the next copy is at least twice as far from it as the best; otherwise the next hint is asked,
@@ -135,6 +139,11 @@ struct RansacMatcherOptions {
 struct SymmetryHint {
   std::optional<Pose3> predicted_T_C_D;
   std::optional<Eigen::Vector3d> gravity_C;
+  std::optional<Eigen::Vector3d> fix_p_D;
+  double fix_sigma_m = 0.0;   // 1 sigma per axis, the fix's age included (m)
+  double fix_gate_sigmas = 4.0;
+  double fix_range_fraction = 0.05;
+  Pose3 T_C_S;                // the fixed point's frame in the camera frame
   std::optional<Eigen::Vector3d> approach_direction_D;
 };
 
@@ -150,6 +159,7 @@ struct RansacMatchResult : MatchResult {
   // (T_C_D composed with each non-identity symmetry), and how the reported one was chosen.
   std::vector<Pose3> symmetric_T_C_D;
   std::string symmetry;
+  bool symmetry_unresolved = false;  // no hint told the copies apart: the pose is one of them
 };
 
 RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, const DockModel& dock,
