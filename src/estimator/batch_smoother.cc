@@ -201,7 +201,8 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
       }
       std::optional<ceres::ResidualBlockId> id;
       if (BatchState* s = state_at_or_before(sample.t_ns)) {
-        id = AddDvlFactor(&problem, sample, *calibration.dvl, dock, blocks_of(s), s->t_ns);
+        id = AddDvlFactor(&problem, sample, *calibration.dvl, dock, blocks_of(s), s->t_ns,
+                          nullptr, sensors.dvl_variance_factor);
       }
       if (id) {
         dvl_residuals.push_back({*id, sample.t_ns});

@@ -33,6 +33,7 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.vision.use_stereo = est.GetBool("use_stereo", e.vision.use_stereo);
   e.adaptive_vision_noise.enabled =
       est.GetBool("adaptive_vision_noise", e.adaptive_vision_noise.enabled);
+  e.adaptive_dvl_noise.enabled = est.GetBool("adaptive_dvl_noise", e.adaptive_dvl_noise.enabled);
   e.vision.stereo_covariance_at_prediction =
       est.GetBool("stereo_covariance_at_prediction", e.vision.stereo_covariance_at_prediction);
   const std::string weighting = est.GetString("stage_weighting", "information");

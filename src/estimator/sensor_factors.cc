@@ -38,7 +38,8 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
                                                    const DvlCalibration& calibration,
                                                    const DockModel& dock,
                                                    const StateBlocks& state, int64_t t_state_ns,
-                                                   const ImuPoseShift* shift) {
+                                                   const ImuPoseShift* shift,
+                                                   double variance_factor) {
   if (!sample.v_S.allFinite() || sample.t_ns < t_state_ns || state.imu == nullptr ||
       state.velocity == nullptr) {
     return std::nullopt;
@@ -50,7 +51,8 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
             : ImuShiftFromState(state, t_state_ns, sample.t_ns - t_state_ns, dock.gravity_D);
   if (!own_shift) return std::nullopt;
   return problem->AddResidualBlock(
-      DvlFactor::Create(sample.v_S, calibration.sigma_mps, calibration.T_B_S,
+      DvlFactor::Create(sample.v_S, calibration.sigma_mps * std::sqrt(variance_factor),
+                        calibration.T_B_S,
                         *gyro - state.bias.gyro, *own_shift),
       nullptr, state.pose, state.velocity);
 }

@@ -47,7 +47,8 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
       imu_(calibration.imu ? *calibration.imu : ImuCalibration(), options.max_imu_gap_s,
            options.imu_noise_scale),
       dvl_rate_test_(calibration.dvl ? *calibration.dvl : DvlCalibration(),
-                     options.dvl_rate_test) {
+                     options.dvl_rate_test),
+      dvl_noise_(options.adaptive_dvl_noise) {
   if (options_.window_size < 2 || options_.max_solver_iterations < 1 ||
       !(options_.vision.huber_sigmas > 0.0) || !(options_.max_imu_gap_s > 0.0) ||
       options_.mono_gate_chi2 < 0.0 || options_.stereo_gate_chi2 < 0.0 ||
@@ -265,9 +266,14 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
       const std::optional<ImuPoseShift> shift =
           ImuShiftFromState(blocks, state->t_ns, sample.t_ns - state->t_ns, dock_.gravity_D);
       if (shift) {
+        dvl_rate_test_.SetNoiseFactor(dvl_noise_.factor());
         const DvlRateVerdict verdict =
             dvl_rate_test_.Check(sample, imu_, blocks.bias,
                                  PoseFromBlock(state->pose).q * shift->delta_q, dock_.gravity_D);
+        if (std::isfinite(verdict.statistic)) {
+          dvl_noise_.Update(std::min(verdict.statistic, options_.dvl_rate_test.gate_chi2), 3.0);
+          stats_.dvl_variance_factor = dvl_noise_.factor();
+        }
         if (!verdict.pass) {
           ++stats_.dvl_rate_rejected;
           rejections_.push_back(
@@ -277,7 +283,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
       }
       // The shift is the one the rate test used: the IMU is preintegrated once per sample.
       id = AddDvlFactor(problem_.get(), sample, *calibration_.dvl, dock_, blocks, state->t_ns,
-                        shift ? &*shift : nullptr);
+                        shift ? &*shift : nullptr, dvl_noise_.factor());
     }
     if (id) {
       added.push_back({*id, sample.t_ns});

@@ -367,6 +367,45 @@ TEST(SlidingWindowEstimatorTest, DvlHoldsTheHorizontalPositionWithoutVisionAndGa
 // The first DVL sample is a spike (nothing else constrains the velocity yet, so the gate would
 // fit it and then reject the clean samples after it: a locked gate). The rate test rejects it
 // for want of a reference, and the clean samples after it are used.
+// A DVL three times noisier than its calibration says (0.03 m/s against 0.01), on a landing
+// whose last 8 s have no lights: the adaptive factor finds the variance ratio of ~9 from the
+// rate test's innovations, and the estimate without lights stays honest; without it the window
+// trusts the DVL three times too much. The calibration's own sigma gives a factor near 1.
+TEST(SlidingWindowEstimatorTest, ADvlNoisierThanConfiguredIsFoundAndTheCovarianceWidens) {
+  Scenario scenario = test::DefaultScenario();
+  scenario.duration_s = 40.0;
+  scenario.dvl.sigma_mps = 0.03;
+  scenario.dvl_faults.gross_error_probability = 0.0;
+  test::SyntheticRun noisy = test::MakeSyntheticRun(scenario, 8);
+  noisy.calibration.dvl->sigma_mps = 0.01;
+  DarkenFramesAfter(24.0, &noisy);
+  double nees[2] = {0.0, 0.0};
+  for (const bool adaptive : {false, true}) {
+    EstimatorOptions options;
+    options.adaptive_dvl_noise.enabled = adaptive;
+    SlidingWindowEstimator estimator(noisy.calibration, noisy.dock, options);
+    const RunErrors errors = RunEstimator(noisy, &estimator, 24.5, true, true);
+    ASSERT_GT(errors.nees_count, 100);
+    nees[adaptive] = errors.nees_sum / errors.nees_count;
+    if (adaptive) {
+      EXPECT_GT(estimator.stats().dvl_variance_factor, 9.0 * 0.7);
+      EXPECT_LT(estimator.stats().dvl_variance_factor, 9.0 * 1.4);
+    } else {
+      EXPECT_EQ(estimator.stats().dvl_variance_factor, 1.0);
+    }
+  }
+  std::printf("mean NEES without lights, DVL 3x noisier than configured: fixed %.2f, adaptive %.2f\n",
+              nees[0], nees[1]);
+  EXPECT_LT(nees[1], 0.8 * nees[0]);
+
+  scenario.dvl.sigma_mps = 0.01;
+  test::SyntheticRun as_configured = test::MakeSyntheticRun(scenario, 8);
+  SlidingWindowEstimator estimator(as_configured.calibration, as_configured.dock);
+  RunEstimator(as_configured, &estimator, 2.0, true, true);
+  EXPECT_GT(estimator.stats().dvl_variance_factor, 0.7);
+  EXPECT_LT(estimator.stats().dvl_variance_factor, 1.4);
+}
+
 TEST(SlidingWindowEstimatorTest, ASpikeAsTheFirstDvlSampleDoesNotLockTheGate) {
   Scenario scenario = test::DefaultScenario();
   scenario.duration_s = 8.0;

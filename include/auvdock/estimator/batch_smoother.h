@@ -71,6 +71,9 @@ struct BatchResult {
 struct NavigationSamples {
   std::vector<DepthMeasurement> depth;
   std::vector<DvlMeasurement> dvl;
+  // The DVL's variance factor (the window's adaptive estimate, EstimatorStats::
+  // dvl_variance_factor): multiplies its configured variance.
+  double dvl_variance_factor = 1.0;
 };
 
 // frames: every vision frame of the log, in time order (frames without a warm-start state are

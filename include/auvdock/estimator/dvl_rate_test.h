@@ -9,8 +9,9 @@
 //   v_B(t)   = dR^T (v_B(t_r) + dv) + R_Bt_D g_D dt        (dR = R_Br_Bt, dv: preintegrated)
 //   v_S(t)   = R_S_B (v_B(t) + w_B(t) x p_B_S)
 // and the whitened difference d = v_S - v_S(t) predicted, with covariance
-//   (2 sigma^2 + (accel_sigma dt)^2) I          (two samples' noise; the IMU's unmodelled part:
-//                                                bias error, attitude error on g, per second)
+//   (2 lambda sigma^2 + (accel_sigma dt)^2) I   (two samples' noise, lambda the adaptive variance
+//                                                factor, SetNoiseFactor; the IMU's unmodelled
+//                                                part: bias error, attitude error on g, per second)
 // is tested against gate_chi2 (3 dof). A sample that passes is a candidate; it becomes the
 // reference when the estimator's own chi-square gate keeps it as well (Confirm), so that a
 // long bias the rate test lets through once the reference has aged is not the next reference
@@ -65,6 +66,10 @@ class DvlRateTest {
   // becomes the reference. Candidates that are never confirmed are dropped by the next Check.
   void Confirm(int64_t t_ns);
 
+  // The DVL's variance factor in use (adaptive_noise_scale.h: its effective noise over the
+  // configured sigma, squared): the samples' part of the variance above is 2 factor sigma^2.
+  void SetNoiseFactor(double factor) { noise_factor_ = factor > 0.0 ? factor : 1.0; }
+
   // Forgets the reference (after a reset of the estimator).
   void Reset() {
     reference_.reset();
@@ -77,6 +82,7 @@ class DvlRateTest {
     Eigen::Vector3d w_B = Eigen::Vector3d::Zero();
     bool confirmed = false;  // passed a test itself
   };
+  double noise_factor_ = 1.0;
 
   DvlCalibration calibration_;
   DvlRateTestOptions options_;

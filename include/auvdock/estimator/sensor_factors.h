@@ -37,13 +37,15 @@ std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
 // The same for a DVL sample; nothing also when the IMU has no gyro sample at its time. A sample
 // that is not finite (bottom lock lost) is no measurement.
 // shift: the IMU's motion from the state to the sample when the caller has it already
-// (ImuShiftFromState), else it is computed here.
+// (ImuShiftFromState), else it is computed here. variance_factor multiplies the configured
+// variance (the adaptive estimate of the DVL's effective noise, adaptive_noise_scale.h).
 std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
                                                    const DvlMeasurement& sample,
                                                    const DvlCalibration& calibration,
                                                    const DockModel& dock,
                                                    const StateBlocks& state, int64_t t_state_ns,
-                                                   const ImuPoseShift* shift = nullptr);
+                                                   const ImuPoseShift* shift = nullptr,
+                                                   double variance_factor = 1.0);
 
 // Why a sample cannot be a measurement whatever the state (empty when it can): a depth above
 // the surface by more than 0.5 m (a pressure sensor reads slightly negative at the surface, a

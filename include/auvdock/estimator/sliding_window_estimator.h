@@ -98,6 +98,15 @@ struct EstimatorOptions {
   // which does not model the slowly varying part, then becomes overconfident (default scenario
   // NEES 8.4 instead of 5.7; README, "Real water and any dock").
   AdaptiveNoiseOptions adaptive_vision_noise = AdaptiveNoiseOptions{/*enabled=*/false};
+  // Online variance factor of the DVL (the same mechanism, adaptive_noise_scale.h), from the
+  // rate-of-change test's innovations (dvl_rate_test.h): the difference of two samples against
+  // the IMU's velocity change, whose statistic has the expectation 3 when the configured sigma
+  // is right, and which does not depend on the state's estimate (so no leverage: redundancy 3).
+  // Each statistic counts up to the test's gate (a spike moves the factor by no more than a
+  // sample at the gate), so a DVL much noisier than configured, whose samples first mostly fail
+  // the test, still raises the factor until they pass. The factor sets the rate test's and the
+  // DVL factor's variance (and so the gate's). Needs dvl_rate_test.
+  AdaptiveNoiseOptions adaptive_dvl_noise;
   // Batch smoother only (estimator/batch_smoother.h): the slowly varying part of the detection
   // errors, per pixel coordinate (1-sigma, px) and its correlation time (s); either 0 = white
   // errors only. The sliding window ignores them. README, "Vision noise".
@@ -173,6 +182,7 @@ struct EstimatorStats {
   // The adaptive variance factors in use at the end, per light id.
   std::map<int, double> mono_variance_factor;
   std::map<int, double> stereo_variance_factor;
+  double dvl_variance_factor = 1.0;  // adaptive_dvl_noise's factor in use at the end
   std::vector<std::string> log;  // one line per skip/reset, for the caller's log
 };
 
@@ -254,6 +264,7 @@ class SlidingWindowEstimator {
   std::deque<DvlMeasurement> pending_dvl_;
   std::vector<Rejection> rejections_;  // not yet taken
   DvlRateTest dvl_rate_test_;
+  AdaptiveNoiseScale dvl_noise_;  // the DVL's variance factor (adaptive_dvl_noise)
   HeldDvlReadingCheck held_dvl_reading_;
   int64_t last_depth_sample_t_ns_ = INT64_MIN;  // of the newest sample taken
   int64_t last_dvl_sample_t_ns_ = INT64_MIN;
