@@ -19,6 +19,16 @@ TEST(EstimatorConfigTest, ShippedDefaultsEqualTheBuiltInOnes) {
   EXPECT_EQ(config.estimator.smoother_vision_correlation_time_s,
             defaults.smoother_vision_correlation_time_s);
   EXPECT_EQ(config.estimator.window_size, defaults.window_size);
+  EXPECT_EQ(config.estimator.adaptive_dvl_noise.enabled, defaults.adaptive_dvl_noise.enabled);
+}
+
+TEST(EstimatorConfigTest, AdaptiveDvlNoiseSwitch) {
+  const test::TempDir dir;
+  const std::string path = dir.path() + "/estimator.yaml";
+  { std::ofstream(path) << "estimator:\n  adaptive_dvl_noise: false\n"; }
+  EXPECT_FALSE(LoadRunConfig(path).estimator.adaptive_dvl_noise.enabled);
+  { std::ofstream(path) << "estimator:\n  adaptive_dvl_noise: maybe\n"; }
+  EXPECT_THROW(LoadRunConfig(path), InputError);
 }
 
 TEST(EstimatorConfigTest, SmootherVisionNoiseKeys) {
