@@ -39,7 +39,8 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
   summary["warnings"] = source.warnings();
   summary["adaptive_variance_factor"] = {{"mono", stats.mono_variance_factor},
                                          {"stereo", stats.stereo_variance_factor},
-                                         {"dvl", stats.dvl_variance_factor}};
+                                         {"dvl", stats.dvl_variance_factor},
+                                         {"depth", stats.depth_variance_factor}};
   summary["resets"] = stats.resets;
   summary["solver_failures"] = stats.solver_failures;
   summary["covariance_failures"] = stats.covariance_failures;

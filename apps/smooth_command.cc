@@ -86,7 +86,8 @@ void Smooth(const SmoothOptions& options) {
   const BatchResult result = SmoothBatch(dataset.calibration, *dataset.dock, frames, dataset.imu,
                                          estimator.History(), config.estimator, batch,
                                          NavigationSamples{dataset.depth, dataset.dvl,
-                                                           estimator.stats().dvl_variance_factor});
+                                                           estimator.stats().dvl_variance_factor,
+                                                           estimator.stats().depth_variance_factor});
   counters.backend_s += Seconds(Clock::now() - t0);
   if (!options.quiet) std::fprintf(stderr, "\n");
 

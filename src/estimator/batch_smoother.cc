@@ -176,7 +176,8 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
       }
       std::optional<ceres::ResidualBlockId> id;
       if (BatchState* s = state_at_or_before(sample.t_ns)) {
-        id = AddDepthFactor(&problem, sample, *calibration.depth, dock, blocks_of(s), s->t_ns);
+        id = AddDepthFactor(&problem, sample, *calibration.depth, dock, blocks_of(s), s->t_ns,
+                            sensors.depth_variance_factor);
       }
       if (id) {
         depth_residuals.push_back({*id, sample.t_ns});

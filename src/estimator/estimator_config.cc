@@ -34,6 +34,8 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.adaptive_vision_noise.enabled =
       est.GetBool("adaptive_vision_noise", e.adaptive_vision_noise.enabled);
   e.adaptive_dvl_noise.enabled = est.GetBool("adaptive_dvl_noise", e.adaptive_dvl_noise.enabled);
+  e.adaptive_depth_noise.enabled =
+      est.GetBool("adaptive_depth_noise", e.adaptive_depth_noise.enabled);
   e.vision.stereo_covariance_at_prediction =
       est.GetBool("stereo_covariance_at_prediction", e.vision.stereo_covariance_at_prediction);
   const std::string weighting = est.GetString("stage_weighting", "information");

@@ -14,14 +14,15 @@ std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
                                                      const DepthMeasurement& sample,
                                                      const DepthCalibration& calibration,
                                                      const DockModel& dock,
-                                                     const StateBlocks& state, int64_t t_state_ns) {
+                                                     const StateBlocks& state, int64_t t_state_ns,
+                                                     double variance_factor) {
   if (!std::isfinite(sample.depth_m) || sample.t_ns < t_state_ns) return std::nullopt;
   const std::optional<ImuPoseShift> shift =
       ImuShiftFromState(state, t_state_ns, sample.t_ns - t_state_ns, dock.gravity_D);
   if (!shift) return std::nullopt;
   auto factor =
-      std::make_unique<DepthFactor>(sample.depth_m, calibration.sigma_m, dock.origin_depth_m,
-                                    dock.gravity_D, calibration.T_B_S.p);
+      std::make_unique<DepthFactor>(sample.depth_m, calibration.sigma_m * std::sqrt(variance_factor),
+                                    dock.origin_depth_m, dock.gravity_D, calibration.T_B_S.p);
   if (shift->dt_s == 0.0) {
     return problem->AddResidualBlock(
         new ceres::AutoDiffCostFunction<DepthFactor, kDepthResidualSize, kPoseSize>(

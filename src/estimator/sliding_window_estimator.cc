@@ -48,7 +48,8 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
            options.imu_noise_scale),
       dvl_rate_test_(calibration.dvl ? *calibration.dvl : DvlCalibration(),
                      options.dvl_rate_test),
-      dvl_noise_(options.adaptive_dvl_noise) {
+      dvl_noise_(options.adaptive_dvl_noise),
+      depth_noise_(options.adaptive_depth_noise) {
   if (options_.window_size < 2 || options_.max_solver_iterations < 1 ||
       !(options_.vision.huber_sigmas > 0.0) || !(options_.max_imu_gap_s > 0.0) ||
       options_.mono_gate_chi2 < 0.0 || options_.stereo_gate_chi2 < 0.0 ||
@@ -208,6 +209,11 @@ void SlidingWindowEstimator::AddDepth(const DepthMeasurement& sample) {
     return;
   }
   last_depth_sample_t_ns_ = sample.t_ns;
+  if (const std::optional<double> statistic =
+          depth_innovation_.Add(sample, calibration_.depth->sigma_m, depth_noise_.factor())) {
+    depth_noise_.Update(std::min(*statistic, options_.depth_gate_chi2), 1.0);
+    stats_.depth_variance_factor = depth_noise_.factor();
+  }
   pending_depth_.push_back(sample);
 }
 
@@ -243,7 +249,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDepth(int64_t t_ns) {
     if (State* state = StateAtOrBefore(sample.t_ns)) {
       id = AddDepthFactor(problem_.get(), sample, *calibration_.depth, dock_,
                           StateBlocks(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias)),
-                          state->t_ns);
+                          state->t_ns, depth_noise_.factor());
     }
     if (id) {
       added.push_back({*id, sample.t_ns});

@@ -406,6 +406,26 @@ TEST(SlidingWindowEstimatorTest, ADvlNoisierThanConfiguredIsFoundAndTheCovarianc
   EXPECT_LT(estimator.stats().dvl_variance_factor, 1.4);
 }
 
+// The same for the depth sensor: three times noisier than configured (0.06 m against 0.02),
+// its factor finds ~9 from the samples' second differences; as configured, ~1.
+TEST(SlidingWindowEstimatorTest, ADepthSensorNoisierThanConfiguredIsFound) {
+  Scenario scenario = test::DefaultScenario();
+  scenario.duration_s = 40.0;
+  for (const double truth_sigma : {0.06, 0.02}) {
+    scenario.depth.sigma_m = truth_sigma;
+    test::SyntheticRun run = test::MakeSyntheticRun(scenario, 9);
+    run.calibration.depth->sigma_m = 0.02;
+    SlidingWindowEstimator estimator(run.calibration, run.dock);
+    RunEstimator(run, &estimator, 2.0, /*with_depth=*/true);
+    const double expected = std::pow(truth_sigma / 0.02, 2);
+    std::printf("depth sigma %.2f m, configured 0.02 m: variance factor %.2f (expected %.1f)\n",
+                truth_sigma, estimator.stats().depth_variance_factor, expected);
+    EXPECT_GT(estimator.stats().depth_variance_factor, 0.7 * expected) << truth_sigma;
+    EXPECT_LT(estimator.stats().depth_variance_factor, 1.4 * expected) << truth_sigma;
+    EXPECT_GT(estimator.stats().depth_used, 200);
+  }
+}
+
 TEST(SlidingWindowEstimatorTest, ASpikeAsTheFirstDvlSampleDoesNotLockTheGate) {
   Scenario scenario = test::DefaultScenario();
   scenario.duration_s = 8.0;

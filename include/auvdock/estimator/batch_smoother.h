@@ -74,6 +74,7 @@ struct NavigationSamples {
   // The DVL's variance factor (the window's adaptive estimate, EstimatorStats::
   // dvl_variance_factor): multiplies its configured variance.
   double dvl_variance_factor = 1.0;
+  double depth_variance_factor = 1.0;  // the same for the depth
 };
 
 // frames: every vision frame of the log, in time order (frames without a warm-start state are

@@ -28,11 +28,14 @@ namespace auvdock {
 
 // The sample's residual on `state` (whose time is t_state_ns <= sample.t_ns); nothing when the
 // sample is not finite or the IMU does not reach its time.
+// variance_factor multiplies the configured variance (the adaptive estimate of the sensor's
+// effective noise, adaptive_noise_scale.h).
 std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
                                                      const DepthMeasurement& sample,
                                                      const DepthCalibration& calibration,
                                                      const DockModel& dock,
-                                                     const StateBlocks& state, int64_t t_state_ns);
+                                                     const StateBlocks& state, int64_t t_state_ns,
+                                                     double variance_factor = 1.0);
 
 // The same for a DVL sample; nothing also when the IMU has no gyro sample at its time. A sample
 // that is not finite (bottom lock lost) is no measurement.

@@ -51,6 +51,7 @@
 #include "auvdock/estimator/imu_buffer.h"
 #include "auvdock/estimator/stage_weighting.h"
 #include "auvdock/estimator/adaptive_noise_scale.h"
+#include "auvdock/estimator/depth_second_difference.h"
 #include "auvdock/estimator/dvl_rate_test.h"
 #include "auvdock/estimator/rejection.h"
 #include "auvdock/estimator/sensor_factors.h"
@@ -107,6 +108,10 @@ struct EstimatorOptions {
   // the test, still raises the factor until they pass. The factor sets the rate test's and the
   // DVL factor's variance (and so the gate's). Needs dvl_rate_test.
   AdaptiveNoiseOptions adaptive_dvl_noise;
+  // The same for the pressure depth, from the second difference of consecutive samples
+  // (depth_second_difference.h: state-free, chi-square 1 dof), each statistic counted up to
+  // depth_gate_chi2. Time constant 100 samples (10 s at 10 Hz): one dof per sample.
+  AdaptiveNoiseOptions adaptive_depth_noise = AdaptiveNoiseOptions{true, 100.0};
   // Batch smoother only (estimator/batch_smoother.h): the slowly varying part of the detection
   // errors, per pixel coordinate (1-sigma, px) and its correlation time (s); either 0 = white
   // errors only. The sliding window ignores them. README, "Vision noise".
@@ -183,6 +188,7 @@ struct EstimatorStats {
   std::map<int, double> mono_variance_factor;
   std::map<int, double> stereo_variance_factor;
   double dvl_variance_factor = 1.0;  // adaptive_dvl_noise's factor in use at the end
+  double depth_variance_factor = 1.0;  // adaptive_depth_noise's
   std::vector<std::string> log;  // one line per skip/reset, for the caller's log
 };
 
@@ -265,6 +271,8 @@ class SlidingWindowEstimator {
   std::vector<Rejection> rejections_;  // not yet taken
   DvlRateTest dvl_rate_test_;
   AdaptiveNoiseScale dvl_noise_;  // the DVL's variance factor (adaptive_dvl_noise)
+  AdaptiveNoiseScale depth_noise_;  // the depth's (adaptive_depth_noise)
+  DepthSecondDifference depth_innovation_;
   HeldDvlReadingCheck held_dvl_reading_;
   int64_t last_depth_sample_t_ns_ = INT64_MIN;  // of the newest sample taken
   int64_t last_dvl_sample_t_ns_ = INT64_MIN;
