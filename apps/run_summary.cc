@@ -35,6 +35,9 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                             {"no_bottom_lock", stats.dvl_no_lock},
                             {"rate_test_rejected", stats.dvl_rate_rejected},
                             {"skipped", stats.dvl_skipped}};
+  summary["usbl_fixes"] = {{"used", stats.usbl_used},
+                           {"gated", stats.usbl_gated},
+                           {"skipped", stats.usbl_skipped}};
   summary["no_vision_reasons"] = source.no_vision_reasons();
   summary["warnings"] = source.warnings();
   summary["adaptive_variance_factor"] = {{"mono", stats.mono_variance_factor},

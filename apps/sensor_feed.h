@@ -1,6 +1,7 @@
 // Feeds a dataset's sensor streams into the sliding window in time order, as `run` and `smooth`
 // both do: the IMU up to the time a prediction is asked for (causal: samples at or before it),
-// and before each frame every stream (IMU, depth, DVL) up to the frame's last image.
+// and before each frame every stream (IMU, depth, DVL, acoustic fixes) up to the frame's last
+// image.
 #pragma once
 
 #include <cstddef>
@@ -32,6 +33,9 @@ class SensorFeed {
     while (next_dvl_ < dataset_.dvl.size() && dataset_.dvl[next_dvl_].t_ns <= t_ns) {
       estimator_->AddDvl(dataset_.dvl[next_dvl_++]);
     }
+    while (next_usbl_ < dataset_.acoustic.size() && dataset_.acoustic[next_usbl_].t_ns <= t_ns) {
+      estimator_->AddUsbl(dataset_.acoustic[next_usbl_++]);
+    }
   }
 
  private:
@@ -40,6 +44,7 @@ class SensorFeed {
   size_t next_imu_ = 0;
   size_t next_depth_ = 0;
   size_t next_dvl_ = 0;
+  size_t next_usbl_ = 0;
 };
 
 }  // namespace auvdock

@@ -87,7 +87,8 @@ void Smooth(const SmoothOptions& options) {
                                          estimator.History(), config.estimator, batch,
                                          NavigationSamples{dataset.depth, dataset.dvl,
                                                            estimator.stats().dvl_variance_factor,
-                                                           estimator.stats().depth_variance_factor});
+                                                           estimator.stats().depth_variance_factor,
+                                                           dataset.acoustic});
   counters.backend_s += Seconds(Clock::now() - t0);
   if (!options.quiet) std::fprintf(stderr, "\n");
 
@@ -121,6 +122,9 @@ void Smooth(const SmoothOptions& options) {
   stats.dvl_gated = result.stats.dvl_gated;
   stats.dvl_no_lock = result.stats.dvl_no_lock;
   stats.dvl_skipped = result.stats.dvl_skipped;
+  stats.usbl_used = result.stats.usbl_used;
+  stats.usbl_gated = result.stats.usbl_gated;
+  stats.usbl_skipped = result.stats.usbl_skipped;
   nlohmann::json summary = MakeRunSummary(source, stats, skipped_rows, counters);
   summary["batch"] = {{"segments", result.segments},
                       {"iterations", result.iterations},

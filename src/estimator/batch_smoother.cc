@@ -213,6 +213,24 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
       }
     }
   }
+  std::vector<SensorResidual> usbl_residuals;
+  if (estimator_options.use_usbl && calibration.acoustic) {
+    int64_t last_t_ns = INT64_MIN;
+    for (const AcousticFix& fix : sensors.usbl) {
+      std::optional<ceres::ResidualBlockId> id;
+      BatchState* s = fix.t_ns > last_t_ns ? state_at_or_before(fix.t_ns) : nullptr;
+      if (s) id = AddUsblFactor(&problem, fix, *calibration.acoustic, dock, blocks_of(s), s->t_ns);
+      if (id) {
+        usbl_residuals.push_back({*id, fix.t_ns});
+        last_t_ns = fix.t_ns;
+      } else {
+        ++result.stats.usbl_skipped;
+        result.rejections.push_back({fix.t_ns, calibration.acoustic->name, kNoStatistic,
+                                     fix.t_ns <= last_t_ns ? "out of order or repeated"
+                                                           : kNoStateReason});
+      }
+    }
+  }
 
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
@@ -239,8 +257,16 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
                : GateSensorResiduals(&problem, estimator_options.dvl_gate_chi2,
                                      calibration.dvl->name, &dvl_residuals, &result.rejections);
   };
+  const auto gate_usbl = [&] {
+    return usbl_residuals.empty()
+               ? 0
+               : GateSensorResiduals(&problem, estimator_options.usbl_gate_chi2,
+                                     calibration.acoustic->name, &usbl_residuals,
+                                     &result.rejections);
+  };
   result.stats.depth_gated = gate_depth();
   result.stats.dvl_gated = gate_dvl();
+  result.stats.usbl_gated = gate_usbl();
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
   result.initial_cost = summary.initial_cost;
@@ -257,7 +283,10 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   const int dvl_gated_after = gate_dvl();
   result.stats.dvl_gated += dvl_gated_after;
   result.stats.dvl_used = static_cast<int>(dvl_residuals.size());
-  if (gated > 0 || depth_gated_after > 0 || dvl_gated_after > 0) {
+  const int usbl_gated_after = gate_usbl();
+  result.stats.usbl_gated += usbl_gated_after;
+  result.stats.usbl_used = static_cast<int>(usbl_residuals.size());
+  if (gated > 0 || depth_gated_after > 0 || dvl_gated_after > 0 || usbl_gated_after > 0) {
     ceres::Solve(solver, &problem, &summary);
   }
   std::stable_sort(result.rejections.begin(), result.rejections.end(),

@@ -7,6 +7,7 @@
 #include "factors/depth_factor.h"
 #include "factors/dvl_factor.h"
 #include "factors/time_shifted_factor.h"
+#include "factors/usbl_fix_factor.h"
 
 namespace auvdock {
 
@@ -55,6 +56,30 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
       DvlFactor::Create(sample.v_S, calibration.sigma_mps * std::sqrt(variance_factor),
                         calibration.T_B_S,
                         *gyro - state.bias.gyro, *own_shift),
+      nullptr, state.pose, state.velocity);
+}
+
+std::optional<ceres::ResidualBlockId> AddUsblFactor(ceres::Problem* problem,
+                                                    const AcousticFix& fix,
+                                                    const AcousticCalibration& calibration,
+                                                    const DockModel& dock,
+                                                    const StateBlocks& state, int64_t t_state_ns) {
+  if (!fix.p_D.allFinite() || !std::isfinite(fix.sigma_m) || !(fix.sigma_m > 0.0) ||
+      fix.t_ns < t_state_ns) {
+    return std::nullopt;
+  }
+  const std::optional<ImuPoseShift> shift =
+      ImuShiftFromState(state, t_state_ns, fix.t_ns - t_state_ns, dock.gravity_D);
+  if (!shift) return std::nullopt;
+  auto factor = std::make_unique<UsblFixFactor>(fix.p_D, fix.sigma_m, calibration.T_B_S.p);
+  if (shift->dt_s == 0.0) {
+    return problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<UsblFixFactor, kUsblResidualSize, kPoseSize>(
+            factor.release()),
+        nullptr, state.pose);
+  }
+  return problem->AddResidualBlock(
+      TimeShiftedFactor<UsblFixFactor, kUsblResidualSize>::Create(std::move(factor), *shift),
       nullptr, state.pose, state.velocity);
 }
 

@@ -217,6 +217,44 @@ void SlidingWindowEstimator::AddDepth(const DepthMeasurement& sample) {
   pending_depth_.push_back(sample);
 }
 
+void SlidingWindowEstimator::AddUsbl(const AcousticFix& fix) {
+  if (!options_.use_usbl || !calibration_.acoustic) return;
+  std::string problem;
+  if (!fix.p_D.allFinite() || !std::isfinite(fix.sigma_m) || !(fix.sigma_m > 0.0)) {
+    problem = "not finite or no positive sigma";
+  } else if (fix.t_ns <= last_usbl_sample_t_ns_) {
+    problem = "out of order or repeated";
+  }
+  if (!problem.empty()) {
+    ++stats_.usbl_skipped;
+    rejections_.push_back({fix.t_ns, calibration_.acoustic->name, kNoStatistic, problem});
+    return;
+  }
+  last_usbl_sample_t_ns_ = fix.t_ns;
+  pending_usbl_.push_back(fix);
+}
+
+std::vector<SensorResidual> SlidingWindowEstimator::AttachUsbl(int64_t t_ns) {
+  std::vector<SensorResidual> added;
+  while (!pending_usbl_.empty() && pending_usbl_.front().t_ns <= t_ns) {
+    const AcousticFix fix = pending_usbl_.front();
+    pending_usbl_.pop_front();
+    std::optional<ceres::ResidualBlockId> id;
+    if (State* state = StateAtOrBefore(fix.t_ns)) {
+      id = AddUsblFactor(problem_.get(), fix, *calibration_.acoustic, dock_,
+                         StateBlocks(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias)),
+                         state->t_ns);
+    }
+    if (id) {
+      added.push_back({*id, fix.t_ns});
+    } else {
+      ++stats_.usbl_skipped;
+      rejections_.push_back({fix.t_ns, calibration_.acoustic->name, kNoStatistic, kNoStateReason});
+    }
+  }
+  return added;
+}
+
 void SlidingWindowEstimator::AddDvl(const DvlMeasurement& sample) {
   if (!options_.use_dvl || !calibration_.dvl) return;
   if (!sample.v_S.allFinite()) {
@@ -381,6 +419,7 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
                                    &stats_.skipped_observations);
   std::vector<SensorResidual> depth = AttachDepth(frame.t_ns);
   std::vector<SensorResidual> dvl = AttachDvl(frame.t_ns);
+  std::vector<SensorResidual> usbl = AttachUsbl(frame.t_ns);
 
   if (!Solve()) {
     ++stats_.solver_failures;
@@ -401,11 +440,17 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
                                         calibration_.dvl->name, &dvl, &rejections_);
   stats_.dvl_gated += dvl_gated;
   stats_.dvl_used += static_cast<int>(dvl.size());
+  const int usbl_gated =
+      usbl.empty() ? 0
+                   : GateSensorResiduals(problem_.get(), options_.usbl_gate_chi2,
+                                         calibration_.acoustic->name, &usbl, &rejections_);
+  stats_.usbl_gated += usbl_gated;
+  stats_.usbl_used += static_cast<int>(usbl.size());
   for (const SensorResidual& kept : dvl) {
     dvl_rate_test_.Confirm(kept.t_ns);
     last_dvl_t_ns_ = std::max(last_dvl_t_ns_, kept.t_ns);
   }
-  if ((state->n_gated > 0 || depth_gated > 0 || dvl_gated > 0) && !Solve()) {
+  if ((state->n_gated > 0 || depth_gated > 0 || dvl_gated > 0 || usbl_gated > 0) && !Solve()) {
     ++stats_.solver_failures;
     Reset("solver failed at " + std::to_string(frame.t_ns) + " ns (after gating)");
     return std::nullopt;

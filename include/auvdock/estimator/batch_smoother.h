@@ -75,6 +75,7 @@ struct NavigationSamples {
   // dvl_variance_factor): multiplies its configured variance.
   double dvl_variance_factor = 1.0;
   double depth_variance_factor = 1.0;  // the same for the depth
+  std::vector<AcousticFix> usbl;        // acoustic fixes (estimator_options.use_usbl)
 };
 
 // frames: every vision frame of the log, in time order (frames without a warm-start state are

@@ -9,6 +9,8 @@
 //   depth  factors/depth_factor.h  1 residual, on the pose (and the velocity when shifted)
 //   DVL    factors/dvl_factor.h    3 residuals, on the pose and the velocity; the body rate from
 //                                  the gyro held at t minus the state's gyro bias
+//   USBL   factors/usbl_fix_factor.h  3 residuals, on the pose (and the velocity when shifted);
+//                                  the fix's own sigma (range-dependent, from the sensor)
 #pragma once
 
 #include <cstdint>
@@ -49,6 +51,14 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
                                                    const StateBlocks& state, int64_t t_state_ns,
                                                    const ImuPoseShift* shift = nullptr,
                                                    double variance_factor = 1.0);
+
+// The same for an acoustic (USBL) fix of the transponder; nothing also when its sigma is not
+// positive and finite.
+std::optional<ceres::ResidualBlockId> AddUsblFactor(ceres::Problem* problem,
+                                                    const AcousticFix& fix,
+                                                    const AcousticCalibration& calibration,
+                                                    const DockModel& dock,
+                                                    const StateBlocks& state, int64_t t_state_ns);
 
 // Why a sample cannot be a measurement whatever the state (empty when it can): a depth above
 // the surface by more than 0.5 m (a pressure sensor reads slightly negative at the surface, a

@@ -134,6 +134,10 @@ struct EstimatorOptions {
   // that is not finite is bottom lock lost: no measurement, counted apart.
   bool use_dvl = true;
   double dvl_gate_chi2 = 16.27;
+  // Acoustic (USBL) fixes of the transponder (the same, needs the calibration's acoustic
+  // sensor): 3 dof, p = 0.999, with each fix's own sigma.
+  bool use_usbl = true;
+  double usbl_gate_chi2 = 16.27;
   // Multiplies the calibration's IMU noise densities and random walks (sigma, not variance).
   // Datasheet values are measured on a bench, at constant temperature, without vibration; on a
   // vehicle the effective noise is larger (a real EuRoC sequence gives a chi-square about 100x
@@ -184,6 +188,9 @@ struct EstimatorStats {
   int dvl_no_lock = 0;    // not finite: bottom lock lost
   int dvl_skipped = 0;    // out of order, held, before the first state or beyond the IMU
   int dvl_rate_rejected = 0;  // failed the rate-of-change test
+  int usbl_used = 0;      // acoustic fixes in the cost (after gating)
+  int usbl_gated = 0;     // beyond the USBL gate
+  int usbl_skipped = 0;   // not finite, out of order, no state or IMU
   // The adaptive variance factors in use at the end, per light id.
   std::map<int, double> mono_variance_factor;
   std::map<int, double> stereo_variance_factor;
@@ -219,6 +226,8 @@ class SlidingWindowEstimator {
   void AddDepth(const DepthMeasurement& sample);
   // A DVL sample, the same way.
   void AddDvl(const DvlMeasurement& sample);
+  // An acoustic fix, the same way (by its measurement time).
+  void AddUsbl(const AcousticFix& fix);
 
   // A camera frame (identified lights; possibly none). Returns the newest state's estimate, or
   // nothing before initialisation / after a reset until the next per-frame pose.
@@ -250,6 +259,7 @@ class SlidingWindowEstimator {
   // residuals added.
   std::vector<SensorResidual> AttachDepth(int64_t t_ns);
   std::vector<SensorResidual> AttachDvl(int64_t t_ns);
+  std::vector<SensorResidual> AttachUsbl(int64_t t_ns);
   // The latest state at or before t_ns, or nullptr.
   State* StateAtOrBefore(int64_t t_ns);
   EstimatorOutput Output(const State& state);
@@ -268,6 +278,7 @@ class SlidingWindowEstimator {
   std::vector<StateRecord> history_;
   std::deque<DepthMeasurement> pending_depth_;
   std::deque<DvlMeasurement> pending_dvl_;
+  std::deque<AcousticFix> pending_usbl_;
   std::vector<Rejection> rejections_;  // not yet taken
   DvlRateTest dvl_rate_test_;
   AdaptiveNoiseScale dvl_noise_;  // the DVL's variance factor (adaptive_dvl_noise)
@@ -276,6 +287,7 @@ class SlidingWindowEstimator {
   HeldDvlReadingCheck held_dvl_reading_;
   int64_t last_depth_sample_t_ns_ = INT64_MIN;  // of the newest sample taken
   int64_t last_dvl_sample_t_ns_ = INT64_MIN;
+  int64_t last_usbl_sample_t_ns_ = INT64_MIN;
   int64_t last_frame_t_ns_ = INT64_MIN;
   int64_t last_vision_t_ns_ = INT64_MIN;
   bool symmetry_unresolved_ = false;  // of the window's first pose (EstimatorOutput)
