@@ -21,18 +21,11 @@ std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
   const std::optional<ImuPoseShift> shift =
       ImuShiftFromState(state, t_state_ns, sample.t_ns - t_state_ns, dock.gravity_D);
   if (!shift) return std::nullopt;
-  auto factor =
+  return AddOnState<DepthFactor, kDepthResidualSize>(
+      problem,
       std::make_unique<DepthFactor>(sample.depth_m, calibration.sigma_m * std::sqrt(variance_factor),
-                                    dock.origin_depth_m, dock.gravity_D, calibration.T_B_S.p);
-  if (shift->dt_s == 0.0) {
-    return problem->AddResidualBlock(
-        new ceres::AutoDiffCostFunction<DepthFactor, kDepthResidualSize, kPoseSize>(
-            factor.release()),
-        nullptr, state.pose);
-  }
-  return problem->AddResidualBlock(
-      TimeShiftedFactor<DepthFactor, kDepthResidualSize>::Create(std::move(factor), *shift),
-      nullptr, state.pose, state.velocity);
+                                    dock.origin_depth_m, dock.gravity_D, calibration.T_B_S.p),
+      *shift, nullptr, state);
 }
 
 std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
@@ -71,16 +64,9 @@ std::optional<ceres::ResidualBlockId> AddUsblFactor(ceres::Problem* problem,
   const std::optional<ImuPoseShift> shift =
       ImuShiftFromState(state, t_state_ns, fix.t_ns - t_state_ns, dock.gravity_D);
   if (!shift) return std::nullopt;
-  auto factor = std::make_unique<UsblFixFactor>(fix.p_D, fix.sigma_m, calibration.T_B_S.p);
-  if (shift->dt_s == 0.0) {
-    return problem->AddResidualBlock(
-        new ceres::AutoDiffCostFunction<UsblFixFactor, kUsblResidualSize, kPoseSize>(
-            factor.release()),
-        nullptr, state.pose);
-  }
-  return problem->AddResidualBlock(
-      TimeShiftedFactor<UsblFixFactor, kUsblResidualSize>::Create(std::move(factor), *shift),
-      nullptr, state.pose, state.velocity);
+  return AddOnState<UsblFixFactor, kUsblResidualSize>(
+      problem, std::make_unique<UsblFixFactor>(fix.p_D, fix.sigma_m, calibration.T_B_S.p), *shift,
+      nullptr, state);
 }
 
 std::string ImplausibleDepth(const DepthMeasurement& sample) {

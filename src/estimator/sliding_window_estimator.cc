@@ -235,24 +235,12 @@ void SlidingWindowEstimator::AddUsbl(const AcousticFix& fix) {
 }
 
 std::vector<SensorResidual> SlidingWindowEstimator::AttachUsbl(int64_t t_ns) {
-  std::vector<SensorResidual> added;
-  while (!pending_usbl_.empty() && pending_usbl_.front().t_ns <= t_ns) {
-    const AcousticFix fix = pending_usbl_.front();
-    pending_usbl_.pop_front();
-    std::optional<ceres::ResidualBlockId> id;
-    if (State* state = StateAtOrBefore(fix.t_ns)) {
-      id = AddUsblFactor(problem_.get(), fix, *calibration_.acoustic, dock_,
-                         StateBlocks(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias)),
-                         state->t_ns);
-    }
-    if (id) {
-      added.push_back({*id, fix.t_ns});
-    } else {
-      ++stats_.usbl_skipped;
-      rejections_.push_back({fix.t_ns, calibration_.acoustic->name, kNoStatistic, kNoStateReason});
-    }
-  }
-  return added;
+  return AttachPending(&pending_usbl_, t_ns, calibration_.acoustic->name, &stats_.usbl_skipped,
+                       [&](const AcousticFix& fix, State& state) {
+                         return AddUsblFactor(problem_.get(), fix, *calibration_.acoustic, dock_,
+                                              BlocksOf(state),
+                                              state.t_ns);
+                       });
 }
 
 void SlidingWindowEstimator::AddDvl(const DvlMeasurement& sample) {
@@ -272,31 +260,45 @@ void SlidingWindowEstimator::AddDvl(const DvlMeasurement& sample) {
   pending_dvl_.push_back(sample);
 }
 
+StateBlocks SlidingWindowEstimator::BlocksOf(State& state) const {
+  return StateBlocks(state.pose, state.velocity, &imu_, BiasFromBlock(state.bias));
+}
+
 SlidingWindowEstimator::State* SlidingWindowEstimator::StateAtOrBefore(int64_t t_ns) {
   auto it = std::find_if(window_.rbegin(), window_.rend(),
                          [&](const std::unique_ptr<State>& s) { return s->t_ns <= t_ns; });
   return it == window_.rend() ? nullptr : it->get();
 }
 
-std::vector<SensorResidual> SlidingWindowEstimator::AttachDepth(int64_t t_ns) {
+template <typename Sample, typename AddFactor>
+std::vector<SensorResidual> SlidingWindowEstimator::AttachPending(std::deque<Sample>* pending,
+                                                                  int64_t t_ns,
+                                                                  const std::string& sensor,
+                                                                  int* skipped,
+                                                                  const AddFactor& add) {
   std::vector<SensorResidual> added;
-  while (!pending_depth_.empty() && pending_depth_.front().t_ns <= t_ns) {
-    const DepthMeasurement sample = pending_depth_.front();
-    pending_depth_.pop_front();
+  while (!pending->empty() && pending->front().t_ns <= t_ns) {
+    const Sample sample = pending->front();
+    pending->pop_front();
     std::optional<ceres::ResidualBlockId> id;
-    if (State* state = StateAtOrBefore(sample.t_ns)) {
-      id = AddDepthFactor(problem_.get(), sample, *calibration_.depth, dock_,
-                          StateBlocks(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias)),
-                          state->t_ns, depth_noise_.factor());
-    }
+    if (State* state = StateAtOrBefore(sample.t_ns)) id = add(sample, *state);
     if (id) {
       added.push_back({*id, sample.t_ns});
     } else {
-      ++stats_.depth_skipped;
-      rejections_.push_back({sample.t_ns, calibration_.depth->name, kNoStatistic, kNoStateReason});
+      ++*skipped;
+      rejections_.push_back({sample.t_ns, sensor, kNoStatistic, kNoStateReason});
     }
   }
   return added;
+}
+
+std::vector<SensorResidual> SlidingWindowEstimator::AttachDepth(int64_t t_ns) {
+  return AttachPending(&pending_depth_, t_ns, calibration_.depth->name, &stats_.depth_skipped,
+                       [&](const DepthMeasurement& sample, State& state) {
+                         return AddDepthFactor(problem_.get(), sample, *calibration_.depth, dock_,
+                                               BlocksOf(state),
+                                              state.t_ns, depth_noise_.factor());
+                       });
 }
 
 std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
@@ -306,7 +308,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
     pending_dvl_.pop_front();
     std::optional<ceres::ResidualBlockId> id;
     if (State* state = StateAtOrBefore(sample.t_ns)) {
-      const StateBlocks blocks(state->pose, state->velocity, &imu_, BiasFromBlock(state->bias));
+      const StateBlocks blocks = BlocksOf(*state);
       const std::optional<ImuPoseShift> shift =
           ImuShiftFromState(blocks, state->t_ns, sample.t_ns - state->t_ns, dock_.gravity_D);
       if (shift) {

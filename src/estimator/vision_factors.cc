@@ -50,21 +50,6 @@ double Factor(const std::map<int, double>& factors, int light_id) {
   return it == factors.end() ? 1.0 : it->second;
 }
 
-// Adds `factor` on the state's pose, or through the shift on its pose and velocity.
-template <typename Factor, int kResiduals>
-ceres::ResidualBlockId AddResidual(ceres::Problem* problem, std::unique_ptr<Factor> factor,
-                                   const ImuPoseShift& shift, ceres::LossFunction* loss,
-                                   const StateBlocks& state) {
-  if (shift.dt_s == 0.0) {
-    return problem->AddResidualBlock(
-        new ceres::AutoDiffCostFunction<Factor, kResiduals, kPoseSize>(factor.release()), loss,
-        state.pose);
-  }
-  return problem->AddResidualBlock(
-      TimeShiftedFactor<Factor, kResiduals>::Create(std::move(factor), shift), loss, state.pose,
-      state.velocity);
-}
-
 }  // namespace
 
 double CorrelatedVisionVariance(double floor_px, double correlation_time_s,
@@ -126,7 +111,7 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
       ++*n_skipped;
       continue;
     }
-    const ceres::ResidualBlockId id = AddResidual<MonoReprojectionFactor, kMonoResidualSize>(
+    const ceres::ResidualBlockId id = AddOnState<MonoReprojectionFactor, kMonoResidualSize>(
         problem, std::move(factor), *mono_shift, WeightedHuber(options.huber_sigmas, weights.mono),
         state);
     added.push_back({id, true, obs.light_id, weights.mono, frame.t_ns + frame.mono_dt_ns,
@@ -152,7 +137,7 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
       }
     }
     const double scale = Factor(options.stereo_variance_factor, obs.light_id) * stereo_scale;
-    const ceres::ResidualBlockId id = AddResidual<StereoPointFactor, kStereoPointResidualSize>(
+    const ceres::ResidualBlockId id = AddOnState<StereoPointFactor, kStereoPointResidualSize>(
         problem,
         std::make_unique<StereoPointFactor>(obs.p_S, scale * covariance, rig.stereo_left->T_B_C,
                                             light->p_D),

@@ -260,6 +260,14 @@ class SlidingWindowEstimator {
   std::vector<SensorResidual> AttachDepth(int64_t t_ns);
   std::vector<SensorResidual> AttachDvl(int64_t t_ns);
   std::vector<SensorResidual> AttachUsbl(int64_t t_ns);
+  // The pending samples up to t_ns, each by add(sample, state) onto the state at or before it
+  // (the factor, or nothing: then, as without a state, skipped with kNoStateReason).
+  template <typename Sample, typename AddFactor>
+  std::vector<SensorResidual> AttachPending(std::deque<Sample>* pending, int64_t t_ns,
+                                            const std::string& sensor, int* skipped,
+                                            const AddFactor& add);
+  // The state's blocks for the measurement factors (estimator/state_blocks.h).
+  StateBlocks BlocksOf(State& state) const;
   // The latest state at or before t_ns, or nullptr.
   State* StateAtOrBefore(int64_t t_ns);
   EstimatorOutput Output(const State& state);

@@ -8,8 +8,12 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
+#include <utility>
 
+#include <ceres/autodiff_cost_function.h>
+#include <ceres/problem.h>
 #include <Eigen/Core>
 
 #include "auvdock/estimator/imu_buffer.h"
@@ -36,5 +40,23 @@ struct StateBlocks {
 // the interval.
 std::optional<ImuPoseShift> ImuShiftFromState(const StateBlocks& state, int64_t t_state_ns,
                                               int64_t dt_ns, const Eigen::Vector3d& gravity_D);
+
+// Adds `factor` (an automatic-differentiation functor on the pose block with kResiduals
+// residuals, e.g. factors/depth_factor.h) on the state: directly on its pose when the shift is
+// the identity (dt 0), else through the shift on its pose and velocity (TimeShiftedFactor).
+// loss may be null. The one way every measurement factor joins a state.
+template <typename Factor, int kResiduals>
+ceres::ResidualBlockId AddOnState(ceres::Problem* problem, std::unique_ptr<Factor> factor,
+                                  const ImuPoseShift& shift, ceres::LossFunction* loss,
+                                  const StateBlocks& state) {
+  if (shift.dt_s == 0.0) {
+    return problem->AddResidualBlock(
+        new ceres::AutoDiffCostFunction<Factor, kResiduals, kPoseSize>(factor.release()), loss,
+        state.pose);
+  }
+  return problem->AddResidualBlock(
+      TimeShiftedFactor<Factor, kResiduals>::Create(std::move(factor), shift), loss, state.pose,
+      state.velocity);
+}
 
 }  // namespace auvdock
