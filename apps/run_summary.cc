@@ -37,6 +37,7 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                             {"skipped", stats.dvl_skipped}};
   summary["usbl_fixes"] = {{"used", stats.usbl_used},
                            {"gated", stats.usbl_gated},
+                           {"rate_test_rejected", stats.usbl_rate_rejected},
                            {"skipped", stats.usbl_skipped}};
   summary["no_vision_reasons"] = source.no_vision_reasons();
   summary["warnings"] = source.warnings();

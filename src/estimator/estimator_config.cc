@@ -26,6 +26,9 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.dvl_gate_chi2 = est.GetNonNegative("dvl_gate_chi2", e.dvl_gate_chi2);
   e.use_usbl = est.GetBool("use_usbl", e.use_usbl);
   e.usbl_gate_chi2 = est.GetNonNegative("usbl_gate_chi2", e.usbl_gate_chi2);
+  e.usbl_rate_test.enabled = est.GetBool("usbl_rate_test", e.usbl_rate_test.enabled);
+  e.usbl_rate_test.max_speed_mps =
+      est.GetPositive("usbl_rate_max_speed_mps", e.usbl_rate_test.max_speed_mps);
   e.dvl_rate_test.enabled = est.GetBool("dvl_rate_test", e.dvl_rate_test.enabled);
   e.dvl_rate_test.gate_chi2 = est.GetPositive("dvl_rate_gate_chi2", e.dvl_rate_test.gate_chi2);
   e.dvl_rate_test.accel_sigma_mps2 =

@@ -49,7 +49,8 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
       dvl_rate_test_(calibration.dvl ? *calibration.dvl : DvlCalibration(),
                      options.dvl_rate_test),
       dvl_noise_(options.adaptive_dvl_noise),
-      depth_noise_(options.adaptive_depth_noise) {
+      depth_noise_(options.adaptive_depth_noise),
+      usbl_rate_test_(options.usbl_rate_test) {
   if (options_.window_size < 2 || options_.max_solver_iterations < 1 ||
       !(options_.vision.huber_sigmas > 0.0) || !(options_.max_imu_gap_s > 0.0) ||
       options_.mono_gate_chi2 < 0.0 || options_.stereo_gate_chi2 < 0.0 ||
@@ -231,6 +232,12 @@ void SlidingWindowEstimator::AddUsbl(const AcousticFix& fix) {
     return;
   }
   last_usbl_sample_t_ns_ = fix.t_ns;
+  const UsblRateVerdict verdict = usbl_rate_test_.Check(fix);
+  if (!verdict.pass) {
+    ++stats_.usbl_rate_rejected;
+    rejections_.push_back({fix.t_ns, calibration_.acoustic->name, verdict.excess, verdict.reason});
+    return;
+  }
   pending_usbl_.push_back(fix);
 }
 
@@ -448,6 +455,7 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
                                          calibration_.acoustic->name, &usbl, &rejections_);
   stats_.usbl_gated += usbl_gated;
   stats_.usbl_used += static_cast<int>(usbl.size());
+  for (const SensorResidual& kept : usbl) usbl_rate_test_.Confirm(kept.t_ns);
   for (const SensorResidual& kept : dvl) {
     dvl_rate_test_.Confirm(kept.t_ns);
     last_dvl_t_ns_ = std::max(last_dvl_t_ns_, kept.t_ns);

@@ -470,10 +470,11 @@ TEST(SlidingWindowEstimatorTest, AcousticFixesHoldThePositionWithoutVisionAndAnO
     }
     const EstimatorStats& stats = estimator.stats();
     if (with_usbl) {
-      EXPECT_GE(stats.usbl_gated, 1);
+      EXPECT_GE(stats.usbl_gated + stats.usbl_rate_rejected, 1);
       EXPECT_GE(stats.usbl_used, static_cast<int>(fixes.size()) - 3);
       EXPECT_TRUE(std::any_of(rejections.begin(), rejections.end(), [&](const Rejection& r) {
-        return r.t_ns == fixes[8].t_ns && r.reason.find("gate") != std::string::npos;
+        return r.t_ns == fixes[8].t_ns && (r.reason.find("gate") != std::string::npos ||
+                                           r.reason.find("rate test") != std::string::npos);
       }));
     } else {
       EXPECT_EQ(stats.usbl_used, 0);

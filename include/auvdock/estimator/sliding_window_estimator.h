@@ -52,6 +52,7 @@
 #include "auvdock/estimator/stage_weighting.h"
 #include "auvdock/estimator/adaptive_noise_scale.h"
 #include "auvdock/estimator/depth_second_difference.h"
+#include "auvdock/estimator/usbl_rate_test.h"
 #include "auvdock/estimator/dvl_rate_test.h"
 #include "auvdock/estimator/rejection.h"
 #include "auvdock/estimator/sensor_factors.h"
@@ -138,6 +139,7 @@ struct EstimatorOptions {
   // sensor): 3 dof, p = 0.999, with each fix's own sigma.
   bool use_usbl = true;
   double usbl_gate_chi2 = 16.27;
+  UsblRateTestOptions usbl_rate_test;  // seed 001's rate-of-change test (usbl_rate_test.h)
   // Multiplies the calibration's IMU noise densities and random walks (sigma, not variance).
   // Datasheet values are measured on a bench, at constant temperature, without vibration; on a
   // vehicle the effective noise is larger (a real EuRoC sequence gives a chi-square about 100x
@@ -191,6 +193,7 @@ struct EstimatorStats {
   int usbl_used = 0;      // acoustic fixes in the cost (after gating)
   int usbl_gated = 0;     // beyond the USBL gate
   int usbl_skipped = 0;   // not finite, out of order, no state or IMU
+  int usbl_rate_rejected = 0;  // failed the rate-of-change test
   // The adaptive variance factors in use at the end, per light id.
   std::map<int, double> mono_variance_factor;
   std::map<int, double> stereo_variance_factor;
@@ -292,6 +295,7 @@ class SlidingWindowEstimator {
   AdaptiveNoiseScale dvl_noise_;  // the DVL's variance factor (adaptive_dvl_noise)
   AdaptiveNoiseScale depth_noise_;  // the depth's (adaptive_depth_noise)
   DepthSecondDifference depth_innovation_;
+  UsblRateTest usbl_rate_test_;
   HeldDvlReadingCheck held_dvl_reading_;
   int64_t last_depth_sample_t_ns_ = INT64_MIN;  // of the newest sample taken
   int64_t last_dvl_sample_t_ns_ = INT64_MIN;

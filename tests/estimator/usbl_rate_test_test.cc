@@ -1,0 +1,70 @@
+#include "auvdock/estimator/usbl_rate_test.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+namespace auvdock {
+namespace {
+
+AcousticFix Fix(double t_s, double x, double sigma = 0.1) {
+  AcousticFix f;
+  f.t_ns = static_cast<int64_t>(t_s * 1e9);
+  f.p_D = Eigen::Vector3d(x, 1.0, -4.0);
+  f.sigma_m = sigma;
+  return f;
+}
+
+// A vehicle at 0.5 m/s: every fix passes and, kept by the gate, becomes the reference; a 2 m
+// jump one second later fails (1.5 m/s allowed, 3 sigma) with its reason; the next good fix
+// passes against the last good reference.
+TEST(UsblRateTest, AJumpFasterThanTheVehicleFailsAgainstAConfirmedReference) {
+  UsblRateTest test;
+  EXPECT_TRUE(test.Check(Fix(0.0, -8.0)).pass);  // no reference: no opinion
+  test.Confirm(Fix(0.0, -8.0).t_ns);
+  const UsblRateVerdict good = test.Check(Fix(1.0, -7.5));
+  EXPECT_TRUE(good.pass);
+  // (0.5 - 1.5) / (0.1 sqrt 2)
+  EXPECT_NEAR(good.excess, -1.0 / (0.1 * std::sqrt(2.0)), 1e-9);
+  test.Confirm(Fix(1.0, -7.5).t_ns);
+  const UsblRateVerdict jump = test.Check(Fix(2.0, -5.0));
+  EXPECT_FALSE(jump.pass);
+  EXPECT_NEAR(jump.excess, (2.5 - 1.5) / (0.1 * std::sqrt(2.0)), 1e-9);
+  EXPECT_NE(jump.reason.find("rate test"), std::string::npos);
+  EXPECT_TRUE(test.Check(Fix(3.0, -6.5)).pass);  // 1.0 m in 2 s from the reference
+}
+
+// An outlier as the first fix: the test has no opinion on the next one (the reference never
+// passed itself), so a good fix is not rejected against it and the test does not lock.
+TEST(UsblRateTest, AnOutlierAsTheFirstFixDoesNotLockTheTest) {
+  UsblRateTest test;
+  EXPECT_TRUE(test.Check(Fix(0.0, -3.0)).pass);  // the outlier, kept by a gate with no opinion
+  test.Confirm(Fix(0.0, -3.0).t_ns);
+  EXPECT_TRUE(test.Check(Fix(1.0, -7.5)).pass);  // 4.5 m away: no opinion
+  test.Confirm(Fix(1.0, -7.5).t_ns);
+  EXPECT_TRUE(test.Check(Fix(2.0, -7.0)).pass);
+  test.Confirm(Fix(2.0, -7.0).t_ns);
+  EXPECT_FALSE(test.Check(Fix(3.0, -3.0)).pass);  // now against a tested reference
+}
+
+TEST(UsblRateTest, AnOldReferenceIsDroppedAndAnUnconfirmedCandidateIsNot) {
+  UsblRateTest test;
+  test.Check(Fix(0.0, -8.0));
+  test.Confirm(Fix(0.0, -8.0).t_ns);
+  test.Check(Fix(1.0, -7.5));
+  test.Confirm(Fix(1.0, -7.5).t_ns);
+  // Not confirmed (the gate rejected it): the reference stays at t = 1 s.
+  EXPECT_TRUE(test.Check(Fix(2.0, -7.0)).pass);
+  EXPECT_FALSE(test.Check(Fix(3.0, -3.0)).pass);  // 4.5 m in 2 s from t = 1 s
+  // 20 s later the reference is too old: no opinion.
+  EXPECT_TRUE(test.Check(Fix(21.0, 5.0)).pass);
+  UsblRateTestOptions off;
+  off.enabled = false;
+  UsblRateTest disabled(off);
+  disabled.Check(Fix(0.0, -8.0));
+  disabled.Confirm(0);
+  EXPECT_TRUE(disabled.Check(Fix(1.0, 10.0)).pass);
+}
+
+}  // namespace
+}  // namespace auvdock
