@@ -244,25 +244,22 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   // enough to tell a DVL spike of 0.3 m/s from 1 cm/s noise) before the solve, so that spikes
   // without a robust loss do not pull the whole batch and drag clean samples past the gate with
   // them, and again after it.
+  // One sensor's residuals through its gate (sensor: its calibration, present whenever it has
+  // residuals).
+  const auto gate = [&](std::vector<SensorResidual>* residuals, double gate_chi2,
+                        const auto& sensor) {
+    return residuals->empty() ? 0
+                              : GateSensorResiduals(&problem, gate_chi2, sensor->name, residuals,
+                                                    &result.rejections);
+  };
   const auto gate_depth = [&] {
-    return depth_residuals.empty()
-               ? 0
-               : GateSensorResiduals(&problem, estimator_options.depth_gate_chi2,
-                                     calibration.depth->name, &depth_residuals,
-                                     &result.rejections);
+    return gate(&depth_residuals, estimator_options.depth_gate_chi2, calibration.depth);
   };
   const auto gate_dvl = [&] {
-    return dvl_residuals.empty()
-               ? 0
-               : GateSensorResiduals(&problem, estimator_options.dvl_gate_chi2,
-                                     calibration.dvl->name, &dvl_residuals, &result.rejections);
+    return gate(&dvl_residuals, estimator_options.dvl_gate_chi2, calibration.dvl);
   };
   const auto gate_usbl = [&] {
-    return usbl_residuals.empty()
-               ? 0
-               : GateSensorResiduals(&problem, estimator_options.usbl_gate_chi2,
-                                     calibration.acoustic->name, &usbl_residuals,
-                                     &result.rejections);
+    return gate(&usbl_residuals, estimator_options.usbl_gate_chi2, calibration.acoustic);
   };
   result.stats.depth_gated = gate_depth();
   result.stats.dvl_gated = gate_dvl();

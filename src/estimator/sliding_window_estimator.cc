@@ -437,24 +437,23 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   }
   state->n_gated = GateVisionResiduals(problem_.get(), options_.mono_gate_chi2,
                                        options_.stereo_gate_chi2, &state->vision, &rejections_);
-  const int depth_gated =
-      depth.empty() ? 0
-                    : GateSensorResiduals(problem_.get(), options_.depth_gate_chi2,
-                                          calibration_.depth->name, &depth, &rejections_);
-  stats_.depth_gated += depth_gated;
-  stats_.depth_used += static_cast<int>(depth.size());
+  // One sensor's residuals through its gate, counted (sensor: its calibration, present whenever
+  // it has residuals).
+  const auto gate = [&](std::vector<SensorResidual>* residuals, double gate_chi2,
+                        const auto& sensor, int* gated, int* used) {
+    const int n = residuals->empty() ? 0
+                                     : GateSensorResiduals(problem_.get(), gate_chi2, sensor->name,
+                                                           residuals, &rejections_);
+    *gated += n;
+    *used += static_cast<int>(residuals->size());
+    return n;
+  };
+  const int depth_gated = gate(&depth, options_.depth_gate_chi2, calibration_.depth,
+                               &stats_.depth_gated, &stats_.depth_used);
   const int dvl_gated =
-      dvl.empty() ? 0
-                  : GateSensorResiduals(problem_.get(), options_.dvl_gate_chi2,
-                                        calibration_.dvl->name, &dvl, &rejections_);
-  stats_.dvl_gated += dvl_gated;
-  stats_.dvl_used += static_cast<int>(dvl.size());
-  const int usbl_gated =
-      usbl.empty() ? 0
-                   : GateSensorResiduals(problem_.get(), options_.usbl_gate_chi2,
-                                         calibration_.acoustic->name, &usbl, &rejections_);
-  stats_.usbl_gated += usbl_gated;
-  stats_.usbl_used += static_cast<int>(usbl.size());
+      gate(&dvl, options_.dvl_gate_chi2, calibration_.dvl, &stats_.dvl_gated, &stats_.dvl_used);
+  const int usbl_gated = gate(&usbl, options_.usbl_gate_chi2, calibration_.acoustic,
+                              &stats_.usbl_gated, &stats_.usbl_used);
   for (const SensorResidual& kept : usbl) usbl_rate_test_.Confirm(kept.t_ns);
   for (const SensorResidual& kept : dvl) {
     dvl_rate_test_.Confirm(kept.t_ns);

@@ -93,6 +93,7 @@ std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& ca
     match = result;
     obs->symmetry = result.symmetry;
     obs->symmetry_unresolved = result.symmetry_unresolved;
+    obs->symmetry_by_prediction = result.symmetry_by_prediction;
   }
   if (match.status != MatchStatus::kOk && predicted_T_C_D) {
     const MatchResult tracked = MatchByPrediction(obs->detections, dock_, camera.intrinsics,
@@ -346,7 +347,7 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
       if (obs->status != MatchStatus::kOk || obs->symmetry.empty() || obs->tracked) continue;
       if (obs->symmetry_unresolved) {
         unresolved = true;
-      } else if (obs->symmetry.find("chosen by the prediction") == std::string::npos) {
+      } else if (!obs->symmetry_by_prediction) {
         resolved = true;
       }
     }

@@ -559,8 +559,9 @@ constexpr double kCollinearTolerance = 0.05;
 // copies, and in *note how it was chosen.
 size_t ChooseSymmetricCopy(const std::vector<Pose3>& copies, const DockModel& dock,
                            const std::vector<DockSymmetry>& symmetries, const SymmetryHint& hint,
-                           std::string* note, bool* unresolved) {
+                           std::string* note, bool* unresolved, bool* by_prediction) {
   *unresolved = false;
+  *by_prediction = false;
   constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
   // Angular error (rad) of every copy against the hint; the smallest wins when the next is at
   // least twice as far (a prediction or gravity a few degrees off, copies tens of degrees apart).
@@ -581,7 +582,10 @@ size_t ChooseSymmetricCopy(const std::vector<Pose3>& copies, const DockModel& do
   if (hint.predicted_T_C_D) {
     std::vector<double> error;
     for (const Pose3& c : copies) error.push_back(c.q.angularDistance(hint.predicted_T_C_D->q));
-    if (auto k = pick(error, "the prediction")) return *k;
+    if (auto k = pick(error, "the prediction")) {
+      *by_prediction = true;
+      return *k;
+    }
   }
   if (hint.gravity_C && hint.gravity_C->norm() > 0.0 && dock.gravity_D.norm() > 0.0) {
     const Eigen::Vector3d g_C = hint.gravity_C->normalized();
@@ -914,7 +918,8 @@ RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, con
       copies.emplace_back(Eigen::Quaterniond(R), best_pose.t - R * s.t);
     }
     const size_t chosen = ChooseSymmetricCopy(copies, dock, symmetries, hint, &result.symmetry,
-                                             &result.symmetry_unresolved);
+                                             &result.symmetry_unresolved,
+                                             &result.symmetry_by_prediction);
     result.symmetry = DescribeDockSymmetries(symmetries) + " symmetric dock: " + result.symmetry;
     T_C_D = copies[chosen];
     for (size_t k = 0; k < copies.size(); ++k) {

@@ -177,7 +177,9 @@ TEST(RansacSymmetricDock, AnAcousticFixPicksTheTrueCopyAndAnOutlierTellsNothing)
     // Within 0.3 m of the ring's axis the copies put the transponder within 0.42 m of each
     // other: a 5 cm fix no longer tells them apart with certainty (it may, or stay unresolved).
     if (std::hypot(transponder_D.x(), transponder_D.y()) < 0.3) continue;
-    hint.fix_p_D = transponder_D + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    const Eigen::Vector3d fix_D =
+        transponder_D + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    hint.fix_p_D = fix_D;
     const RansacMatchResult r = MatchRansac(view.detections, dock, camera, {}, rng, hint);
     if (r.status == MatchStatus::kOk) {
       ++ok;
@@ -185,7 +187,7 @@ TEST(RansacSymmetricDock, AnAcousticFixPicksTheTrueCopyAndAnOutlierTellsNothing)
       by_fix += r.symmetry.find("acoustic fix") != std::string::npos;
       EXPECT_FALSE(r.symmetry_unresolved) << r.symmetry << " d=" << std::hypot(transponder_D.x(), transponder_D.y());
     }
-    hint.fix_p_D = *hint.fix_p_D + Eigen::Vector3d(5.0, 0.0, 0.0);
+    hint.fix_p_D = fix_D + Eigen::Vector3d(5.0, 0.0, 0.0);
     const RansacMatchResult o = MatchRansac(view.detections, dock, camera, {}, rng, hint);
     if (o.status != MatchStatus::kOk) continue;
     ++outlier_ok;

@@ -136,6 +136,7 @@ struct CameraObservation {
   std::string reason;
   std::string symmetry;  // how a symmetric dock's pose was chosen (empty: not symmetric)
   bool symmetry_unresolved = false;  // ... by nothing: the pose is one of the rival poses
+  bool symmetry_by_prediction = false;  // ... by the prediction (it follows the track)
   bool tracked = false;  // identified by prediction (tracking) rather than from scratch
   int guided = 0;        // detections added by the second look (steps 6, 7), at the end
   int by_estimate = 0;   // lights identified by the estimate alone (step 7)

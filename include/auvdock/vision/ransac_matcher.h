@@ -160,6 +160,7 @@ struct RansacMatchResult : MatchResult {
   std::vector<Pose3> symmetric_T_C_D;
   std::string symmetry;
   bool symmetry_unresolved = false;  // no hint told the copies apart: the pose is one of them
+  bool symmetry_by_prediction = false;  // the prediction (the track) chose the copy
 };
 
 RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, const DockModel& dock,
