@@ -1,7 +1,7 @@
 // Feeds a dataset's sensor streams into the sliding window in time order, as `run` and `smooth`
 // both do: the IMU up to the time a prediction is asked for (causal: samples at or before it),
 // and before each frame every stream (IMU, depth, DVL, acoustic fixes) up to the frame's last
-// image.
+// image (an acoustic fix by its arrival time, AcousticFix::arrival_t_ns).
 #pragma once
 
 #include <cstddef>
@@ -33,7 +33,10 @@ class SensorFeed {
     while (next_dvl_ < dataset_.dvl.size() && dataset_.dvl[next_dvl_].t_ns <= t_ns) {
       estimator_->AddDvl(dataset_.dvl[next_dvl_++]);
     }
-    while (next_usbl_ < dataset_.acoustic.size() && dataset_.acoustic[next_usbl_].t_ns <= t_ns) {
+    // A fix is fed when it has arrived (its measurement time is earlier; the window attaches it
+    // there), in measurement order: one that overtook an earlier fix waits for it.
+    while (next_usbl_ < dataset_.acoustic.size() &&
+           dataset_.acoustic[next_usbl_].arrival_t_ns() <= t_ns) {
       estimator_->AddUsbl(dataset_.acoustic[next_usbl_++]);
     }
   }

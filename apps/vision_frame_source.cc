@@ -90,8 +90,11 @@ VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind d
   cameras_ = {pipeline_.left_camera(), pipeline_.right_camera(), pipeline_.mono_camera()};
   if (dataset.calibration.acoustic) {
     fixes_ = dataset.acoustic;
-    std::stable_sort(fixes_.begin(), fixes_.end(),
-                     [](const AcousticFix& a, const AcousticFix& b) { return a.t_ns < b.t_ns; });
+    // In arrival order: the pipeline sees a fix only once it has arrived (causal), and ages it
+    // from its measurement time.
+    std::stable_sort(fixes_.begin(), fixes_.end(), [](const AcousticFix& a, const AcousticFix& b) {
+      return a.arrival_t_ns() < b.arrival_t_ns();
+    });
     fix_T_B_S_ = dataset.calibration.acoustic->T_B_S;
   }
   std::array<std::vector<const CameraFrame*>, 3> by_camera;
@@ -142,7 +145,7 @@ std::optional<VisionFrame> VisionFrameSource::Next(const Predictor& predict) {
     if (group.images[c]) images[c] = ReadImage(*group.images[c], *cameras_[c], &unreadable_images_);
   }
   const auto t1 = Clock::now();
-  for (; next_fix_ < fixes_.size() && fixes_[next_fix_].t_ns <= t; ++next_fix_) {
+  for (; next_fix_ < fixes_.size() && fixes_[next_fix_].arrival_t_ns() <= t; ++next_fix_) {
     const AcousticFix& fix = fixes_[next_fix_];
     pipeline_.SetPositionFix(fix.t_ns, fix.p_D, fix.sigma_m, fix_T_B_S_);
   }

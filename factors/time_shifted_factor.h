@@ -13,14 +13,24 @@
 //
 // which is ImuPreintegration::Predict for the pose; the wrapped factor (any functor with a
 // templated operator()(const T* pose_D_B, T* residuals), e.g. MonoReprojectionFactor or
-// StereoPointFactor) is then evaluated at T_D_Bt. dt >= 0: the state is the earliest image of its
-// frame. What the shift leaves out, and why that is safe for dt up to a frame interval:
+// StereoPointFactor) is then evaluated at T_D_Bt.
+//
+// dt < 0 (a measurement from before the oldest state, e.g. an acoustic fix that arrived late,
+// after its time had left the window): the IMU is preintegrated forward over [t, t_k], tau = -dt
+// (dR = R_Bt_Bk, dp, dv in B_t), and the same relations are solved for the earlier state:
+//
+//   R_D_Bt = R_D_Bk dR^T
+//   v_D_t  = v_D_k - g_D tau - R_D_Bt dv
+//   p_D_Bt = p_D_Bk - v_D_t tau - g_D tau^2 / 2 - R_D_Bt dp
+//
+// What the shift leaves out, and why that is safe for |dt| up to a frame interval (and, for a
+// fix whose sigma is centimetres, up to a second):
 //  - the bias: the shift is held at the bias of the state when the factor is added, so
 //    d(shift)/d(b) is not in the Jacobian; a gyro bias error of 0.01 rad/s moves the attitude by
-//    0.5 mrad over dt = 50 ms, an accelerometer bias error of 0.1 m/s^2 the position by 0.13 mm;
+//    0.5 mrad over dt = 50 ms, an accelerometer bias error of 0.1 m/s^2 the position by 0.13 mm
+//    (by 5 cm over 1 s);
 //  - the IMU noise over dt: its covariance (ImuPreintegration::covariance) is ~1e-8 rad^2 and
 //    ~1e-9 m^2 over 50 ms for a tactical-grade IMU, orders below the vision noise.
-// For a dt of seconds (a late acoustic fix) both grow and an extra state is the better model.
 #pragma once
 
 #include <cmath>
@@ -52,9 +62,16 @@ struct ImuPoseShift {
     const Eigen::Map<const Vector3T> v(v_D);
     Eigen::Map<Vector3T> p_t(pose_D_Bt);
     Eigen::Map<Eigen::Quaternion<T>> q_t(pose_D_Bt + 3);
-    const T dt(dt_s);
-    p_t = p_k + v * dt + gravity_D.cast<T>() * T(0.5 * dt_s * dt_s) + q_k * delta_p.cast<T>();
-    q_t = q_k * delta_q.cast<T>();
+    if (dt_s >= 0.0) {
+      const T dt(dt_s);
+      p_t = p_k + v * dt + gravity_D.cast<T>() * T(0.5 * dt_s * dt_s) + q_k * delta_p.cast<T>();
+      q_t = q_k * delta_q.cast<T>();
+      return;
+    }
+    const T tau(-dt_s);
+    q_t = q_k * delta_q.conjugate().cast<T>();
+    const Vector3T v_t = v - gravity_D.cast<T>() * tau - q_t * delta_v.cast<T>();
+    p_t = p_k - v_t * tau - gravity_D.cast<T>() * T(0.5 * dt_s * dt_s) - q_t * delta_p.cast<T>();
   }
 
   // The velocity at t_k + dt: v_D_t = v_D_k + g_D dt + R_D_Bk dv (for factors on the velocity,
@@ -65,22 +82,27 @@ struct ImuPoseShift {
     const Eigen::Map<const Eigen::Quaternion<T>> q_k(pose_D_Bk + 3);
     const Eigen::Map<const Vector3T> v(v_D);
     Eigen::Map<Vector3T> v_t(v_D_t);
-    v_t = v + gravity_D.cast<T>() * T(dt_s) + q_k * delta_v.cast<T>();
+    if (dt_s >= 0.0) {
+      v_t = v + gravity_D.cast<T>() * T(dt_s) + q_k * delta_v.cast<T>();
+      return;
+    }
+    const Eigen::Quaternion<T> q_t = q_k * delta_q.conjugate().cast<T>();
+    v_t = v + gravity_D.cast<T>() * T(dt_s) - q_t * delta_v.cast<T>();
   }
 };
 
 template <typename Factor, int kResiduals>
 class TimeShiftedFactor {
  public:
-  // Throws std::invalid_argument for a negative or non-finite dt or a non-finite shift.
+  // Throws std::invalid_argument for a non-finite dt or shift.
   TimeShiftedFactor(std::unique_ptr<Factor> factor, const ImuPoseShift& shift)
       : factor_(std::move(factor)), shift_(shift) {
     if (!factor_) throw std::invalid_argument("TimeShiftedFactor: no factor");
-    if (!(shift_.dt_s >= 0.0) || !std::isfinite(shift_.dt_s) ||
+    if (!std::isfinite(shift_.dt_s) ||
         !shift_.delta_q.coeffs().allFinite() || !(shift_.delta_q.norm() > 0.0) ||
         !shift_.delta_p.allFinite() || !shift_.delta_v.allFinite() ||
         !shift_.gravity_D.allFinite()) {
-      throw std::invalid_argument("TimeShiftedFactor: dt must be >= 0 and the shift finite");
+      throw std::invalid_argument("TimeShiftedFactor: dt and the shift must be finite");
     }
     shift_.delta_q.normalize();
   }

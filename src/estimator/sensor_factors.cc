@@ -57,8 +57,8 @@ std::optional<ceres::ResidualBlockId> AddUsblFactor(ceres::Problem* problem,
                                                     const AcousticCalibration& calibration,
                                                     const DockModel& dock,
                                                     const StateBlocks& state, int64_t t_state_ns) {
-  if (!fix.p_D.allFinite() || !std::isfinite(fix.sigma_m) || !(fix.sigma_m > 0.0) ||
-      fix.t_ns < t_state_ns) {
+  // A fix from before the state (it arrived late) is shifted backward through the IMU.
+  if (!fix.p_D.allFinite() || !std::isfinite(fix.sigma_m) || !(fix.sigma_m > 0.0)) {
     return std::nullopt;
   }
   const std::optional<ImuPoseShift> shift =

@@ -106,12 +106,17 @@ void SlidingWindowEstimator::AddImu(const ImuSample& sample) {
   }
   ++stats_.imu_samples;
   // Keep what the oldest state's interval needs (or the last second before initialisation),
-  // and what the DVL's rate test needs back to its oldest reference.
+  // what the DVL's rate test needs back to its oldest reference,
   const int64_t rate_test_ns =
       sample.t_ns - static_cast<int64_t>((options_.dvl_rate_test.max_reference_age_s + 0.5) *
                                          kNsPerSecond);
+  // and what a late fix needs back to the oldest state.
+  const int64_t late_fix_ns =
+      window_.empty() ? 0
+                      : window_.front()->t_ns -
+                            static_cast<int64_t>(options_.usbl_max_backward_shift_s * kNsPerSecond);
   imu_.DropBefore(window_.empty() ? sample.t_ns - static_cast<int64_t>(kNsPerSecond)
-                                  : std::min(window_.front()->t_ns, rate_test_ns));
+                                  : std::min({window_.front()->t_ns, rate_test_ns, late_fix_ns}));
 }
 
 bool SlidingWindowEstimator::Initialize(const VisionFrame& frame) {
@@ -245,9 +250,9 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachUsbl(int64_t t_ns) {
   return AttachPending(&pending_usbl_, t_ns, calibration_.acoustic->name, &stats_.usbl_skipped,
                        [&](const AcousticFix& fix, State& state) {
                          return AddUsblFactor(problem_.get(), fix, *calibration_.acoustic, dock_,
-                                              BlocksOf(state),
-                                              state.t_ns);
-                       });
+                                              BlocksOf(state), state.t_ns);
+                       },
+                       options_.usbl_max_backward_shift_s);
 }
 
 void SlidingWindowEstimator::AddDvl(const DvlMeasurement& sample) {
@@ -271,10 +276,16 @@ StateBlocks SlidingWindowEstimator::BlocksOf(State& state) const {
   return StateBlocks(state.pose, state.velocity, &imu_, BiasFromBlock(state.bias));
 }
 
-SlidingWindowEstimator::State* SlidingWindowEstimator::StateAtOrBefore(int64_t t_ns) {
+SlidingWindowEstimator::State* SlidingWindowEstimator::StateFor(int64_t t_ns,
+                                                                double max_before_s) {
   auto it = std::find_if(window_.rbegin(), window_.rend(),
                          [&](const std::unique_ptr<State>& s) { return s->t_ns <= t_ns; });
-  return it == window_.rend() ? nullptr : it->get();
+  if (it != window_.rend()) return it->get();
+  if (!window_.empty() &&
+      window_.front()->t_ns - t_ns <= static_cast<int64_t>(max_before_s * kNsPerSecond)) {
+    return window_.front().get();
+  }
+  return nullptr;
 }
 
 template <typename Sample, typename AddFactor>
@@ -282,13 +293,14 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachPending(std::deque<Sam
                                                                   int64_t t_ns,
                                                                   const std::string& sensor,
                                                                   int* skipped,
-                                                                  const AddFactor& add) {
+                                                                  const AddFactor& add,
+                                                                  double max_before_s) {
   std::vector<SensorResidual> added;
   while (!pending->empty() && pending->front().t_ns <= t_ns) {
     const Sample sample = pending->front();
     pending->pop_front();
     std::optional<ceres::ResidualBlockId> id;
-    if (State* state = StateAtOrBefore(sample.t_ns)) id = add(sample, *state);
+    if (State* state = StateFor(sample.t_ns, max_before_s)) id = add(sample, *state);
     if (id) {
       added.push_back({*id, sample.t_ns});
     } else {
@@ -314,7 +326,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
     const DvlMeasurement sample = pending_dvl_.front();
     pending_dvl_.pop_front();
     std::optional<ceres::ResidualBlockId> id;
-    if (State* state = StateAtOrBefore(sample.t_ns)) {
+    if (State* state = StateFor(sample.t_ns)) {
       const StateBlocks blocks = BlocksOf(*state);
       const std::optional<ImuPoseShift> shift =
           ImuShiftFromState(blocks, state->t_ns, sample.t_ns - state->t_ns, dock_.gravity_D);

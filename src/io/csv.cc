@@ -19,18 +19,23 @@ std::string Trim(const std::string& s) {
 
 }  // namespace
 
-CsvReader::CsvReader(const std::string& path, std::vector<std::string> columns, bool allow_extra)
-    : path_(path), columns_(std::move(columns)), allow_extra_(allow_extra), in_(path) {
+CsvReader::CsvReader(const std::string& path, std::vector<std::string> columns, bool allow_extra,
+                     int optional_last)
+    : path_(path), columns_(std::move(columns)), allow_extra_(allow_extra),
+      optional_last_(optional_last), in_(path) {
   if (!in_) throw InputError(path + ": cannot open file");
 }
 
 void CsvReader::ExpectNamedHeaderRow() {
   const bool saved = allow_extra_;
+  const int saved_optional = optional_last_;
   allow_extra_ = false;
+  optional_last_ = 0;
   std::string expected;
   for (const auto& c : columns_) expected += (expected.empty() ? "" : ",") + c;
   if (!Next()) Fail("empty file: expected the header row '" + expected + "'");
   allow_extra_ = saved;
+  optional_last_ = saved_optional;
   for (std::size_t i = 0; i < columns_.size(); ++i) {
     if (fields_[i] != columns_[i]) {
       Fail("expected the header row '" + expected + "' (column " + std::to_string(i + 1) +
@@ -50,11 +55,14 @@ bool CsvReader::Next() {
     std::string field;
     while (std::getline(ss, field, ',')) fields_.push_back(Trim(field));
     if (!text.empty() && text.back() == ',') fields_.push_back("");
-    const bool count_ok = allow_extra_ ? fields_.size() >= columns_.size()
-                                       : fields_.size() == columns_.size();
+    const std::size_t required = columns_.size() - static_cast<std::size_t>(optional_last_);
+    const bool count_ok = fields_.size() >= required &&
+                          (allow_extra_ || fields_.size() <= columns_.size());
     if (!count_ok) {
-      Fail("expected " + std::to_string(columns_.size()) + " columns, found " +
-           std::to_string(fields_.size()));
+      const std::string expected =
+          optional_last_ == 0 ? std::to_string(columns_.size())
+                              : std::to_string(required) + " to " + std::to_string(columns_.size());
+      Fail("expected " + expected + " columns, found " + std::to_string(fields_.size()));
     }
     return true;
   }

@@ -13,7 +13,8 @@ const char kImuCsvHeader[] =
 const char kCameraCsvHeader[] = "#timestamp [ns],filename";
 const char kDepthCsvHeader[] = "#timestamp [ns],depth [m]";
 const char kDvlCsvHeader[] = "#timestamp [ns],v_S_x [m s^-1],v_S_y [m s^-1],v_S_z [m s^-1]";
-const char kAcousticCsvHeader[] = "#timestamp [ns],p_D_x [m],p_D_y [m],p_D_z [m],sigma [m]";
+const char kAcousticCsvHeader[] =
+    "#timestamp [ns],p_D_x [m],p_D_y [m],p_D_z [m],sigma [m],latency [ns]";
 const char kGroundTruthCsvHeader[] =
     "#timestamp,p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z [],"
     "v_RS_R_x [m s^-1],v_RS_R_y [m s^-1],v_RS_R_z [m s^-1],"
@@ -133,7 +134,9 @@ std::vector<DvlMeasurement> ReadDvlCsv(const std::string& path,
 
 std::vector<AcousticFix> ReadAcousticCsv(const std::string& path,
                                          std::vector<std::string>* skipped) {
-  CsvReader reader(path, {"timestamp", "p_D_x", "p_D_y", "p_D_z", "sigma"});
+  // The latency column is optional (a log without it: the fixes arrived at once).
+  CsvReader reader(path, {"timestamp", "p_D_x", "p_D_y", "p_D_z", "sigma", "latency"},
+                   /*allow_extra=*/false, /*optional_last=*/1);
   std::vector<AcousticFix> out;
   int64_t previous = kNoTime;
   while (reader.Next()) {
@@ -143,6 +146,10 @@ std::vector<AcousticFix> ReadAcousticCsv(const std::string& path,
     m.p_D = Read3(reader, 1);
     m.sigma_m = reader.Double(4);
     if (!(m.sigma_m > 0.0)) reader.FailColumn(4, "must be positive");
+    if (reader.size() > 5) {
+      m.latency_ns = reader.Int64(5);
+      if (m.latency_ns < 0) reader.FailColumn(5, "must not be negative (a fix cannot arrive before it is measured)");
+    }
     out.push_back(m);
   }
   return out;
@@ -213,7 +220,8 @@ std::string DvlCsvRow(const DvlMeasurement& m) {
 }
 
 std::string AcousticCsvRow(const AcousticFix& m) {
-  return Join(m.t_ns, {m.p_D.x(), m.p_D.y(), m.p_D.z(), m.sigma_m});
+  return Join(m.t_ns, {m.p_D.x(), m.p_D.y(), m.p_D.z(), m.sigma_m}) + "," +
+         std::to_string(m.latency_ns);
 }
 
 std::string GroundTruthCsvRow(const GroundTruthState& s) {

@@ -1,6 +1,7 @@
 #include "auvdock/sim/acoustic_simulator.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "auvdock/io/csv.h"
 #include "auvdock/sim/random_stream.h"
@@ -22,6 +23,9 @@ AcousticFix AcousticSimulator::Sample(int64_t t_ns, const KinematicState& s,
   fix.t_ns = t_ns;
   fix.p_D = p_D_S;
   fix.sigma_m = std::max(calibration_.sigma_min_m, calibration_.sigma_range_fraction * range);
+  const double latency_s =
+      faults_.latency_min_s + (faults_.latency_max_s - faults_.latency_min_s) * Uniform01(rng_);
+  fix.latency_ns = static_cast<int64_t>(std::llround(latency_s * 1e9));
   if (!noise_enabled_) return fix;
   fix.p_D += fix.sigma_m * StandardNormal3(rng_);
   if (Uniform01(rng_) < faults_.outlier_probability) {

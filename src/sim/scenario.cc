@@ -173,6 +173,13 @@ Scenario LoadScenario(const std::string& path) {
   s.acoustic_faults.outlier_probability =
       GetProbability(ac, "outlier_probability", s.acoustic_faults.outlier_probability);
   s.acoustic_faults.outlier_m = ac.GetNonNegative("outlier_m", s.acoustic_faults.outlier_m);
+  s.acoustic_faults.latency_min_s =
+      ac.GetNonNegative("latency_min_s", s.acoustic_faults.latency_min_s);
+  s.acoustic_faults.latency_max_s =
+      ac.GetNonNegative("latency_max_s", s.acoustic_faults.latency_max_s);
+  if (s.acoustic_faults.latency_max_s < s.acoustic_faults.latency_min_s) {
+    ac.Fail("latency_max_s", "must not be below latency_min_s");
+  }
 
   root.CheckNoUnknownKeys();
   return s;

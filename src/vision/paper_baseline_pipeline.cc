@@ -389,6 +389,7 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
 void PaperBaselinePipeline::SetPositionFix(int64_t t_ns, const Eigen::Vector3d& p_D,
                                            double sigma_m, const Pose3& T_B_S) {
   if (!p_D.allFinite() || !std::isfinite(sigma_m) || !(sigma_m > 0.0)) return;
+  if (fix_ && t_ns <= fix_->t_ns) return;  // a late fix overtaken by a newer one
   fix_ = PositionFix{t_ns, p_D, sigma_m, T_B_S};
 }
 

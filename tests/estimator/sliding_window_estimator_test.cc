@@ -427,54 +427,90 @@ TEST(SlidingWindowEstimatorTest, ADepthSensorNoisierThanConfiguredIsFound) {
   }
 }
 
-// Acoustic fixes (1 Hz, 5 cm) on a landing whose last 8 s have no lights: they hold the
-// horizontal position that the IMU alone lets drift, and a fix 2 m off is gated with a reason.
-TEST(SlidingWindowEstimatorTest, AcousticFixesHoldThePositionWithoutVisionAndAnOutlierIsGated) {
+// A landing whose last 8 s (by default) have no lights, with acoustic fixes (1 Hz, 5 cm, of the true
+// transponder position, between frames) each arriving latency_s(k) after its measurement.
+struct AcousticLanding {
+  test::SyntheticRun run;
+  std::vector<AcousticFix> fixes;
+  int64_t t_dark = 0;
+};
+
+template <typename Latency>
+AcousticLanding MakeAcousticLanding(const Latency& latency_s, double duration_s = 24.0,
+                                    double dark_after_s = 16.0) {
   Scenario scenario = test::DefaultScenario();
-  scenario.duration_s = 24.0;
-  test::SyntheticRun run = test::MakeSyntheticRun(scenario, 6);
-  ASSERT_TRUE(run.calibration.acoustic.has_value());
+  scenario.duration_s = duration_s;
+  AcousticLanding landing{test::MakeSyntheticRun(scenario, 6), {}, 0};
+  const test::SyntheticRun& run = landing.run;
+  EXPECT_TRUE(run.calibration.acoustic.has_value());
   const Eigen::Vector3d p_B_S = run.calibration.acoustic->T_B_S.p;
   std::mt19937_64 rng(21);
   std::normal_distribution<double> noise(0.0, 0.05);
-  std::vector<AcousticFix> fixes;
   for (size_t k = 5; k < run.truth.size(); k += 10) {
     AcousticFix fix;
     fix.t_ns = run.truth[k].t_ns + 20'000'000;  // between frames: at its own time
     fix.p_D = run.truth[k].T_D_B * p_B_S + Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
     fix.sigma_m = 0.05;
-    fixes.push_back(fix);
+    fix.latency_ns = static_cast<int64_t>(latency_s(landing.fixes.size()) * 1e9);
+    landing.fixes.push_back(fix);
   }
-  fixes[8].p_D.x() += 2.0;
-  const int64_t t_dark = DarkenFramesAfter(16.0, &run);
+  landing.t_dark = DarkenFramesAfter(dark_after_s, &landing.run);
+  return landing;
+}
+
+// Runs the window, each fix fed when it has arrived; returns the largest horizontal error
+// without lights and the RMS of its norm.
+struct UnlitErrors {
+  double max_xy = 0.0;
+  double rms = 0.0;
+};
+
+UnlitErrors RunAcousticLanding(const AcousticLanding& landing, SlidingWindowEstimator* estimator,
+                               std::vector<Rejection>* rejections) {
+  const test::SyntheticRun& run = landing.run;
+  size_t next_imu = 0, next_fix = 0;
+  UnlitErrors errors;
+  int n = 0;
+  for (size_t k = 0; k < run.frames.size(); ++k) {
+    const VisionFrame& frame = run.frames[k];
+    while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= frame.t_ns) {
+      estimator->AddImu(run.imu[next_imu++]);
+    }
+    while (next_fix < landing.fixes.size() &&
+           landing.fixes[next_fix].arrival_t_ns() <= frame.t_ns) {
+      estimator->AddUsbl(landing.fixes[next_fix++]);
+    }
+    const auto out = estimator->AddVisionFrame(frame);
+    for (const Rejection& r : estimator->TakeRejections()) rejections->push_back(r);
+    if (!out || frame.t_ns < landing.t_dark) continue;
+    const Eigen::Vector2d e = (out->T_D_B.p - run.truth[k].T_D_B.p).head<2>();
+    errors.max_xy = std::max(errors.max_xy, e.cwiseAbs().maxCoeff());
+    errors.rms += e.squaredNorm();
+    ++n;
+  }
+  errors.rms = std::sqrt(errors.rms / std::max(1, n));
+  return errors;
+}
+
+// The fixes hold the horizontal position that the IMU alone lets drift, and a fix 2 m off is
+// gated with a reason.
+TEST(SlidingWindowEstimatorTest, AcousticFixesHoldThePositionWithoutVisionAndAnOutlierIsGated) {
+  AcousticLanding landing = MakeAcousticLanding([](size_t) { return 0.0; });
+  landing.fixes[8].p_D.x() += 2.0;
   double max_xy[2] = {0.0, 0.0};
   for (const bool with_usbl : {false, true}) {
     EstimatorOptions options;
     options.use_usbl = with_usbl;
-    SlidingWindowEstimator estimator(run.calibration, run.dock, options);
-    size_t next_imu = 0, next_fix = 0;
+    SlidingWindowEstimator estimator(landing.run.calibration, landing.run.dock, options);
     std::vector<Rejection> rejections;
-    for (size_t k = 0; k < run.frames.size(); ++k) {
-      const VisionFrame& frame = run.frames[k];
-      while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= frame.t_ns) {
-        estimator.AddImu(run.imu[next_imu++]);
-      }
-      while (next_fix < fixes.size() && fixes[next_fix].t_ns <= frame.t_ns) {
-        estimator.AddUsbl(fixes[next_fix++]);
-      }
-      const auto out = estimator.AddVisionFrame(frame);
-      for (const Rejection& r : estimator.TakeRejections()) rejections.push_back(r);
-      if (!out || frame.t_ns < t_dark) continue;
-      const Eigen::Vector2d e = (out->T_D_B.p - run.truth[k].T_D_B.p).head<2>();
-      max_xy[with_usbl] = std::max(max_xy[with_usbl], e.cwiseAbs().maxCoeff());
-    }
+    max_xy[with_usbl] = RunAcousticLanding(landing, &estimator, &rejections).max_xy;
     const EstimatorStats& stats = estimator.stats();
     if (with_usbl) {
       EXPECT_GE(stats.usbl_gated + stats.usbl_rate_rejected, 1);
-      EXPECT_GE(stats.usbl_used, static_cast<int>(fixes.size()) - 3);
+      EXPECT_GE(stats.usbl_used, static_cast<int>(landing.fixes.size()) - 3);
       EXPECT_TRUE(std::any_of(rejections.begin(), rejections.end(), [&](const Rejection& r) {
-        return r.t_ns == fixes[8].t_ns && (r.reason.find("gate") != std::string::npos ||
-                                           r.reason.find("rate test") != std::string::npos);
+        return r.t_ns == landing.fixes[8].t_ns && (r.reason.find("gate") != std::string::npos ||
+                                                   r.reason.find("rate test") != std::string::npos);
       }));
     } else {
       EXPECT_EQ(stats.usbl_used, 0);
@@ -486,6 +522,51 @@ TEST(SlidingWindowEstimatorTest, AcousticFixesHoldThePositionWithoutVisionAndAnO
   // about one fix; between fixes the velocity error of the unlit IMU still grows).
   EXPECT_LT(max_xy[1], 0.6 * max_xy[0]);
   EXPECT_LT(max_xy[1], 0.2);
+}
+
+// Fixes that arrive 0.3-1.2 s after their measurement, fed only on arrival (causal), on the
+// approach at ~0.5 m/s with the lights lost after 5 s: those whose time is still in the window
+// (0.9 s) attach inside it, older ones to its oldest state through the IMU backward. At each
+// frame the newest information is older than with fixes at once, so the error is larger than
+// theirs; it is smaller than with each fix taken for a measurement at its arrival (what a
+// filter without the latency does: biased by the distance travelled meanwhile). A fix older
+// than the window by more than usbl_max_backward_shift_s is rejected with a reason.
+TEST(SlidingWindowEstimatorTest, LateAcousticFixesAttachAtTheirMeasurementTime) {
+  const auto latency_s = [](size_t k) { return 0.3 + 0.3 * static_cast<double>(k % 4); };
+  const AcousticLanding late = MakeAcousticLanding(latency_s, 14.0, 5.0);
+  const AcousticLanding at_once = MakeAcousticLanding([](size_t) { return 0.0; }, 14.0, 5.0);
+  AcousticLanding stamped_at_arrival = late;
+  for (AcousticFix& fix : stamped_at_arrival.fixes) {
+    fix.t_ns = fix.arrival_t_ns();
+    fix.latency_ns = 0;
+  }
+  const AcousticLanding* landings[3] = {&at_once, &late, &stamped_at_arrival};
+  UnlitErrors errors[3];
+  for (int i = 0; i < 3; ++i) {
+    SlidingWindowEstimator estimator(late.run.calibration, late.run.dock, EstimatorOptions());
+    std::vector<Rejection> rejections;
+    errors[i] = RunAcousticLanding(*landings[i], &estimator, &rejections);
+    if (i < 2) EXPECT_GE(estimator.stats().usbl_used, static_cast<int>(late.fixes.size()) - 2);
+  }
+  std::printf("horizontal error without lights (RMS / max): fixes at once %.3f / %.3f m, "
+              "0.3-1.2 s late %.3f / %.3f m, late fixes taken at their arrival %.3f / %.3f m\n",
+              errors[0].rms, errors[0].max_xy, errors[1].rms, errors[1].max_xy, errors[2].rms,
+              errors[2].max_xy);
+  EXPECT_LT(errors[1].rms, errors[2].rms);
+  EXPECT_LT(errors[1].rms, 2.0 * errors[0].rms);
+  EXPECT_LT(errors[1].max_xy, 2.0 * errors[0].max_xy);
+
+  EstimatorOptions no_backward;
+  no_backward.usbl_max_backward_shift_s = 0.2;
+  SlidingWindowEstimator estimator(late.run.calibration, late.run.dock, no_backward);
+  std::vector<Rejection> rejections;
+  RunAcousticLanding(late, &estimator, &rejections);
+  const int no_state = static_cast<int>(
+      std::count_if(rejections.begin(), rejections.end(), [](const Rejection& r) {
+        return r.sensor == "usbl0" && r.reason == kNoStateReason;
+      }));
+  // At least the fixes 1.2 s late (a quarter) are older than the window's 0.9 s + 0.2 s.
+  EXPECT_GE(no_state, static_cast<int>(late.fixes.size()) / 4 - 1);
 }
 
 TEST(SlidingWindowEstimatorTest, ASpikeAsTheFirstDvlSampleDoesNotLockTheGate) {

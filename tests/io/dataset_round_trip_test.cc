@@ -49,7 +49,7 @@ TEST(DatasetRoundTrip, EveryRecordReadsBackIdentically) {
                     v3(), v3() * 1e-4, v3() * 1e-2});
       depth.push_back({t, 30.0 + u(rng)});
       dvl.push_back({t, v3() / 3.0});
-      acoustic.push_back({t, v3(), 0.05 + std::abs(u(rng))});
+      acoustic.push_back({t, v3(), 0.05 + std::abs(u(rng)), 200000000 + 1000 * k});
       visibility.push_back({t, k % 7, k % 5, k % 4,
                             StageFromLightCounts(k % 7, k % 5, k % 4)});
       faults.push_back({t, "dvl0", "gross_error", "dv=0.1;0.2;0.3"});
@@ -82,6 +82,7 @@ TEST(DatasetRoundTrip, EveryRecordReadsBackIdentically) {
     EXPECT_EQ(ds.dvl[i].v_S, dvl[i].v_S);
     EXPECT_EQ(ds.acoustic[i].p_D, acoustic[i].p_D);
     EXPECT_EQ(ds.acoustic[i].sigma_m, acoustic[i].sigma_m);
+    EXPECT_EQ(ds.acoustic[i].latency_ns, acoustic[i].latency_ns);
     EXPECT_EQ(ds.visibility[i].stage, visibility[i].stage);
     EXPECT_EQ(ds.visibility[i].n_mono, visibility[i].n_mono);
     EXPECT_EQ(ds.faults[i].detail, faults[i].detail);

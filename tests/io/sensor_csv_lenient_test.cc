@@ -64,5 +64,33 @@ TEST(SensorCsvLenientTest, LenientReadingSkipsRepeatedTimestamps) {
   EXPECT_THAT(skipped[0], HasSubstr("line 3: timestamp not increasing"));
 }
 
+// The latency column of the acoustic fixes is optional (older logs: the fix arrived at once);
+// a negative latency, or a row with too many columns, names the file, line and column.
+TEST(SensorCsvLenientTest, AcousticLatencyIsOptionalAndMustNotBeNegative) {
+  test::TempDir dir;
+  test::WriteTextFile(dir / "usbl.csv",
+                      "#timestamp [ns],p_D_x,p_D_y,p_D_z,sigma\n1000,1,2,3,0.05\n"
+                      "2000,1,2,3,0.05,700000000\n");
+  const std::vector<AcousticFix> fixes = ReadAcousticCsv(dir / "usbl.csv");
+  ASSERT_EQ(fixes.size(), 2u);
+  EXPECT_EQ(fixes[0].latency_ns, 0);
+  EXPECT_EQ(fixes[1].latency_ns, 700000000);
+  EXPECT_EQ(fixes[1].arrival_t_ns(), 700002000);
+  test::WriteTextFile(dir / "usbl.csv", "1000,1,2,3,0.05,-5\n");
+  try {
+    ReadAcousticCsv(dir / "usbl.csv");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("usbl.csv: line 1: column 'latency': must not be negative"));
+  }
+  test::WriteTextFile(dir / "usbl.csv", "1000,1,2,3,0.05,5,6\n");
+  try {
+    ReadAcousticCsv(dir / "usbl.csv");
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("expected 5 to 6 columns, found 7"));
+  }
+}
+
 }  // namespace
 }  // namespace auvdock

@@ -144,6 +144,9 @@ TEST(DockingSimulator, NoiseFreeSensorsAreExact) {
   for (const auto& fix : ds.acoustic) {
     const KinematicState s = simulator.trajectory().At(simulator.Seconds(fix.t_ns));
     EXPECT_LT((fix.p_D - s.T_D_B * scenario.acoustic.T_B_S.p).norm(), 1e-12);
+    // Late even without noise: latency is timing, not noise.
+    EXPECT_GE(fix.latency_ns, static_cast<int64_t>(scenario.acoustic_faults.latency_min_s * 1e9));
+    EXPECT_LE(fix.latency_ns, static_cast<int64_t>(scenario.acoustic_faults.latency_max_s * 1e9));
   }
   for (const auto& v : ds.dvl) {
     const KinematicState s = simulator.trajectory().At(simulator.Seconds(v.t_ns));

@@ -53,7 +53,8 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
                                                    double variance_factor = 1.0);
 
 // The same for an acoustic (USBL) fix of the transponder; nothing also when its sigma is not
-// positive and finite.
+// positive and finite. A fix may also be earlier than the state (it arrived after its time left
+// the window): the IMU's motion is then applied backward (factors/time_shifted_factor.h).
 std::optional<ceres::ResidualBlockId> AddUsblFactor(ceres::Problem* problem,
                                                     const AcousticFix& fix,
                                                     const AcousticCalibration& calibration,

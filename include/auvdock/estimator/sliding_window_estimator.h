@@ -140,6 +140,10 @@ struct EstimatorOptions {
   bool use_usbl = true;
   double usbl_gate_chi2 = 16.27;
   UsblRateTestOptions usbl_rate_test;  // seed 001's rate-of-change test (usbl_rate_test.h)
+  // A fix arrives late (AcousticFix::latency_ns); one whose time has already left the window by
+  // up to this much attaches to the oldest state through the IMU shifted backward
+  // (factors/time_shifted_factor.h); an older one is rejected ("no state").
+  double usbl_max_backward_shift_s = 1.0;
   // Multiplies the calibration's IMU noise densities and random walks (sigma, not variance).
   // Datasheet values are measured on a bench, at constant temperature, without vibration; on a
   // vehicle the effective noise is larger (a real EuRoC sequence gives a chi-square about 100x
@@ -263,16 +267,18 @@ class SlidingWindowEstimator {
   std::vector<SensorResidual> AttachDepth(int64_t t_ns);
   std::vector<SensorResidual> AttachDvl(int64_t t_ns);
   std::vector<SensorResidual> AttachUsbl(int64_t t_ns);
-  // The pending samples up to t_ns, each by add(sample, state) onto the state at or before it
-  // (the factor, or nothing: then, as without a state, skipped with kNoStateReason).
+  // The pending samples up to t_ns, each by add(sample, state) onto StateFor(its time,
+  // max_before_s) (the factor, or nothing: then, as without a state, skipped with
+  // kNoStateReason).
   template <typename Sample, typename AddFactor>
   std::vector<SensorResidual> AttachPending(std::deque<Sample>* pending, int64_t t_ns,
                                             const std::string& sensor, int* skipped,
-                                            const AddFactor& add);
+                                            const AddFactor& add, double max_before_s = 0.0);
   // The state's blocks for the measurement factors (estimator/state_blocks.h).
   StateBlocks BlocksOf(State& state) const;
-  // The latest state at or before t_ns, or nullptr.
-  State* StateAtOrBefore(int64_t t_ns);
+  // The state a measurement at t_ns attaches to: the newest at or before it, else the oldest
+  // when t_ns is at most max_before_s before it (a late measurement), else none.
+  State* StateFor(int64_t t_ns, double max_before_s = 0.0);
   EstimatorOutput Output(const State& state);
   // The newest frame's vision residuals, with their leverage on the newest pose (its covariance
   // in the tangent space), into the adaptive noise factors of their lights.

@@ -4,7 +4,9 @@
 //
 // A measurement at t >= t_k attaches to state k: at t = t_k directly on its blocks, later through
 // the IMU preintegrated over [t_k, t] at the state's current bias estimate (ImuPoseShift,
-// factors/time_shifted_factor.h), so that no extra state is needed for it.
+// factors/time_shifted_factor.h), so that no extra state is needed for it. A measurement that
+// arrives after its time has left the window (a late acoustic fix) attaches to the oldest state
+// through the IMU over [t, t_0], shifted backward.
 #pragma once
 
 #include <cstdint>
@@ -35,8 +37,9 @@ struct StateBlocks {
   ImuBias bias;
 };
 
-// The IMU's motion from the state's time t_state_ns to dt_ns later: an identity shift for
-// dt_ns <= 0, nothing when the state has no velocity block or IMU, or the IMU does not cover
+// The IMU's motion from the state's time t_state_ns to dt_ns later (dt_ns < 0: earlier, a late
+// measurement from before the oldest state; factors/time_shifted_factor.h): an identity shift
+// for dt_ns == 0, nothing when the state has no velocity block or IMU, or the IMU does not cover
 // the interval.
 std::optional<ImuPoseShift> ImuShiftFromState(const StateBlocks& state, int64_t t_state_ns,
                                               int64_t dt_ns, const Eigen::Vector3d& gravity_D);

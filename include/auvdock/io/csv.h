@@ -17,8 +17,10 @@ namespace auvdock {
 class CsvReader {
  public:
   // Opens the file and reads the header. `columns` are the names used in error messages; a row
-  // must have exactly columns.size() fields (or at least that many when allow_extra).
-  CsvReader(const std::string& path, std::vector<std::string> columns, bool allow_extra = false);
+  // must have exactly columns.size() fields (or at least that many when allow_extra); the last
+  // optional_last of them may be left out (size() says how many a row has).
+  CsvReader(const std::string& path, std::vector<std::string> columns, bool allow_extra = false,
+            int optional_last = 0);
 
   // For user files whose first row names the columns ("X,Y,Z,u,v"): reads that row and
   // throws unless it lists exactly the expected names.
@@ -33,6 +35,7 @@ class CsvReader {
   // (malformed text is not reported here; Double() rejects it).
   bool HasNonFiniteNumber(int first, int last) const;
   const std::string& String(int column) const { return fields_.at(column); }
+  int size() const { return static_cast<int>(fields_.size()); }
   int line() const { return line_; }
   const std::string& path() const { return path_; }
 
@@ -44,6 +47,7 @@ class CsvReader {
   std::string path_;
   std::vector<std::string> columns_;
   bool allow_extra_;
+  int optional_last_;
   std::ifstream in_;
   std::vector<std::string> fields_;
   int line_ = 0;

@@ -39,9 +39,13 @@ struct DvlMeasurement {
 };
 
 struct AcousticFix {
-  int64_t t_ns = 0;
+  int64_t t_ns = 0;  // when the vehicle's position was measured
   Eigen::Vector3d p_D = Eigen::Vector3d::Zero();
   double sigma_m = 0.0;
+  // From the measurement to its arrival on the vehicle (an acoustic fix is computed ashore or
+  // on the dock and sent back: 0.2-1 s late). A causal estimator may use it from arrival_t_ns().
+  int64_t latency_ns = 0;
+  int64_t arrival_t_ns() const { return t_ns + latency_ns; }
 };
 
 struct CameraFrame {
