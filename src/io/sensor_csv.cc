@@ -148,7 +148,9 @@ std::vector<AcousticFix> ReadAcousticCsv(const std::string& path,
     if (!(m.sigma_m > 0.0)) reader.FailColumn(4, "must be positive");
     if (reader.size() > 5) {
       m.latency_ns = reader.Int64(5);
-      if (m.latency_ns < 0) reader.FailColumn(5, "must not be negative (a fix cannot arrive before it is measured)");
+      if (m.latency_ns < 0) {
+        reader.FailColumn(5, "must not be negative (a fix cannot arrive before it is measured)");
+      }
     }
     out.push_back(m);
   }

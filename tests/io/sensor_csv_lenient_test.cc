@@ -76,20 +76,17 @@ TEST(SensorCsvLenientTest, AcousticLatencyIsOptionalAndMustNotBeNegative) {
   EXPECT_EQ(fixes[0].latency_ns, 0);
   EXPECT_EQ(fixes[1].latency_ns, 700000000);
   EXPECT_EQ(fixes[1].arrival_t_ns(), 700002000);
-  test::WriteTextFile(dir / "usbl.csv", "1000,1,2,3,0.05,-5\n");
-  try {
-    ReadAcousticCsv(dir / "usbl.csv");
-    FAIL() << "expected InputError";
-  } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("usbl.csv: line 1: column 'latency': must not be negative"));
-  }
-  test::WriteTextFile(dir / "usbl.csv", "1000,1,2,3,0.05,5,6\n");
-  try {
-    ReadAcousticCsv(dir / "usbl.csv");
-    FAIL() << "expected InputError";
-  } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("expected 5 to 6 columns, found 7"));
-  }
+  const auto expect_error = [&](const char* row, const char* message) {
+    test::WriteTextFile(dir / "usbl.csv", row);
+    try {
+      ReadAcousticCsv(dir / "usbl.csv");
+      FAIL() << "expected InputError for " << row;
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr(message));
+    }
+  };
+  expect_error("1000,1,2,3,0.05,-5\n", "usbl.csv: line 1: column 'latency': must not be negative");
+  expect_error("1000,1,2,3,0.05,5,6\n", "expected 5 to 6 columns, found 7");
 }
 
 }  // namespace
