@@ -3,8 +3,10 @@
 //
 // Runs the paper's per-frame pipeline (PaperBaselinePipeline) over every camera frame and
 // writes, flushed frame by frame (a stopped run keeps every frame written before the stop):
-//   OUTDIR/detections.csv       timestamp_ns,camera,light_id,u,v,radius,score (light_id -1:
-//                               not identified)
+//   OUTDIR/detections.csv       timestamp_ns,camera,light_id,u,v,radius,score,cov_uu,cov_uv,
+//                               cov_vv (io/detections_csv.h; light_id -1: not identified; an
+//                               image without a detection: one row with light_id -1 and the
+//                               rest empty), which `run` / `smooth --detections` replay
 //   OUTDIR/per_frame.tum        the fused body pose T_D_B (TUM), frames with a pose only
 //   OUTDIR/per_frame_stereo.tum the stereo (SVD) pose alone; per_frame_mono.tum the PnP pose
 //   OUTDIR/stages.csv           timestamp_ns,stage,n_<camera>... (identified lights per camera),
@@ -24,6 +26,7 @@
 #include "apps/signal_flag.h"
 #include "auvdock/io/csv.h"
 #include "auvdock/io/dataset.h"
+#include "auvdock/io/detections_csv.h"
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/staged_directory.h"
 #include "auvdock/io/tum_io.h"
@@ -107,8 +110,7 @@ void RunFrontend(const FrontendOptions& options) {
 
   RequireAbsentOrEmptyDirectory(options.out);
   fs::create_directories(options.out);
-  CsvWriter detections(options.out + "/detections.csv",
-                       "#timestamp [ns],camera,light_id,u [px],v [px],radius [px],score");
+  DetectionsCsvWriter detections(options.out + "/detections.csv");
   std::string stage_header = "#timestamp [ns],stage";
   for (const auto* cam : cameras) {
     if (cam) stage_header += ",n_" + cam->name;
@@ -145,13 +147,7 @@ void RunFrontend(const FrontendOptions& options) {
     for (int c = 0; c < 3; ++c) {
       if (!cameras[c]) continue;
       const CameraObservation& obs = *observations[c];
-      for (std::size_t i = 0; i < obs.detections.size(); ++i) {
-        const LightDetection& d = obs.detections[i];
-        const int id = i < obs.light_ids.size() ? obs.light_ids[i] : -1;
-        detections.Line(std::to_string(t) + "," + cameras[c]->name + "," + std::to_string(id) +
-                        "," + FormatDouble(d.uv.x()) + "," + FormatDouble(d.uv.y()) + "," +
-                        FormatDouble(d.radius_px) + "," + FormatDouble(d.score));
-      }
+      if (!images[c].empty()) detections.Append(t, cameras[c]->name, obs.detections, obs.light_ids);
       stage_row += "," + std::to_string(obs.num_identified());
     }
     // Why there is no pose (empty with one); commas would split the column.

@@ -31,6 +31,7 @@ struct RunOptions {
   bool quiet = false;
   std::string detector = "contrast";
   double sync_tolerance_ms = -1.0;  // < 0: half the shortest frame interval
+  std::string detections;           // replay this detections.csv instead of the images
 };
 
 using Clock = std::chrono::steady_clock;
@@ -43,7 +44,7 @@ void Run(const RunOptions& options) {
   const Dataset dataset = LoadDataset(options.dataset, &skipped_rows);
   if (!dataset.calibration.imu) throw InputError(options.dataset + ": calibration has no IMU");
   VisionFrameSource source(dataset, ParseDetectorKind(options.detector),
-                           SyncToleranceNs(options.sync_tolerance_ms));
+                           SyncToleranceNs(options.sync_tolerance_ms), options.detections);
   SlidingWindowEstimator estimator(dataset.calibration, *dataset.dock, config.estimator);
   GoNoGo go_no_go(config.go_no_go);
   EstimateWriter writer(options.out);
@@ -123,6 +124,9 @@ void AddRunCommand(CLI::App& root) {
   sub->add_option("--sync-tolerance-ms", options->sync_tolerance_ms,
                   "Images of different cameras this close in time share one state (default: half "
                   "the shortest frame interval; 0: equal time stamps only)");
+  sub->add_option("--detections", options->detections,
+                  "Replay these light detections (detections.csv: `simulate` with render_images "
+                  "false, `frontend`, or a detector of your own) instead of the images");
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { Run(*options); });
 }

@@ -22,6 +22,8 @@ struct SimulateOptions {
   std::string scenario;
   std::string out;
   std::optional<int64_t> seed;
+  bool detections_only = false;
+  double fault_scale = 1.0;
   bool quiet = false;
 };
 
@@ -31,6 +33,11 @@ void RunSimulate(const SimulateOptions& options) {
     if (*options.seed < 0) throw InputError("--seed: must not be negative");
     scenario.seed = static_cast<uint64_t>(*options.seed);
   }
+  if (options.detections_only) scenario.cameras.render_images = false;
+  if (!(options.fault_scale >= 0.0 && options.fault_scale <= 1000.0)) {
+    throw InputError("--fault-scale: expected a factor in [0, 1000]");
+  }
+  ScaleFaultRates(options.fault_scale, &scenario);
   const CancellationToken cancel = InstallSignalCancellation();
   StagedDirectory out(options.out);
   const DockingSimulator simulator(scenario);
@@ -76,6 +83,12 @@ void AddSimulateCommand(CLI::App& root) {
   sub->add_option("--out", options->out, "Output dataset folder (must not exist or be empty)")
       ->required();
   sub->add_option("--seed", options->seed, "Random seed (overrides the scenario's)");
+  sub->add_flag("--detections-only", options->detections_only,
+                "No images: each camera's light detections into detections.csv (the scenario's "
+                "cameras.synthetic_detections), for run/smooth --detections");
+  sub->add_option("--fault-scale", options->fault_scale,
+                  "Multiply the scenario's fault rates (DVL spikes and biases, acoustic outliers, "
+                  "synthetic misses, spurious blobs and wrong ids) by this factor");
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { RunSimulate(*options); });
 }

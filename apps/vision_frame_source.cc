@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 #include <opencv2/imgcodecs.hpp>
@@ -54,13 +55,13 @@ cv::Mat ReadImage(const CameraFrame& frame, const CameraCalibration& camera, int
 constexpr int64_t kStereoPairToleranceNs = 1000000;
 
 // Half the shortest median frame interval of the cameras (0 with fewer than two images).
-int64_t DefaultSyncTolerance(const std::array<std::vector<const CameraFrame*>, 3>& by_camera) {
+// times: each camera's image times, sorted.
+int64_t DefaultSyncTolerance(const std::array<std::vector<int64_t>, 3>& times) {
   int64_t shortest = INT64_MAX;
-  for (const auto& frames : by_camera) {
+  for (const std::vector<int64_t>& t : times) {
     std::vector<int64_t> intervals;
-    for (size_t k = 1; k < frames.size(); ++k) {
-      if (frames[k]->t_ns > frames[k - 1]->t_ns)
-        intervals.push_back(frames[k]->t_ns - frames[k - 1]->t_ns);
+    for (size_t k = 1; k < t.size(); ++k) {
+      if (t[k] > t[k - 1]) intervals.push_back(t[k] - t[k - 1]);
     }
     if (intervals.empty()) continue;
     std::nth_element(intervals.begin(), intervals.begin() + intervals.size() / 2, intervals.end());
@@ -68,6 +69,34 @@ int64_t DefaultSyncTolerance(const std::array<std::vector<const CameraFrame*>, 3
   }
   return shortest == INT64_MAX ? 0 : shortest / 2 - 1;
 }
+
+// Frames (see the header): the earliest unused image and each other camera's next image within
+// the tolerance after it. Per frame, the index of each camera's image, or -1.
+std::vector<std::array<int, 3>> GroupFrames(const std::array<std::vector<int64_t>, 3>& times,
+                                            int64_t sync_tolerance_ns) {
+  std::vector<std::array<int, 3>> frames;
+  std::array<size_t, 3> next{};
+  for (;;) {
+    int64_t t0 = INT64_MAX;
+    for (int c = 0; c < 3; ++c) {
+      if (next[c] < times[c].size()) t0 = std::min(t0, times[c][next[c]]);
+    }
+    if (t0 == INT64_MAX) break;
+    std::array<int, 3> frame = {-1, -1, -1};
+    for (int c = 0; c < 3; ++c) {
+      const std::vector<int64_t>& t = times[c];
+      if (next[c] < t.size() && t[next[c]] - t0 <= sync_tolerance_ns) {
+        frame[c] = static_cast<int>(next[c]++);
+        // A repeated time stamp of one camera: its first image is used.
+        while (next[c] < t.size() && t[next[c]] == t[static_cast<size_t>(frame[c])]) ++next[c];
+      }
+    }
+    frames.push_back(frame);
+  }
+  return frames;
+}
+
+bool FileExists(const std::string& path) { return std::filesystem::is_regular_file(path); }
 
 }  // namespace
 
@@ -85,7 +114,8 @@ int64_t SyncToleranceNs(double milliseconds) {
 }
 
 VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind detector,
-                                     int64_t sync_tolerance_ns)
+                                     int64_t sync_tolerance_ns,
+                                     const std::string& detections_path)
     : pipeline_(dataset.calibration, RequireDock(dataset), PipelineOptions(detector)) {
   cameras_ = {pipeline_.left_camera(), pipeline_.right_camera(), pipeline_.mono_camera()};
   if (dataset.calibration.acoustic) {
@@ -97,39 +127,58 @@ VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind d
     });
     fix_T_B_S_ = dataset.calibration.acoustic->T_B_S;
   }
+  if (!detections_path.empty()) ReadReplay(detections_path, dataset);
+  // Each camera's images (or, in replay, its images' detections), in time order.
   std::array<std::vector<const CameraFrame*>, 3> by_camera;
+  std::array<std::vector<const ImageDetections*>, 3> replay_by_camera;
+  std::array<std::vector<int64_t>, 3> times;
   for (int c = 0; c < 3; ++c) {
-    if (!cameras_[c] || !dataset.camera_frames.count(cameras_[c]->name)) continue;
+    if (!cameras_[c]) continue;
+    if (!detections_path.empty()) {
+      for (const ImageDetections& image : replay_) {
+        if (image.camera == cameras_[c]->name) replay_by_camera[c].push_back(&image);
+      }
+      for (const ImageDetections* image : replay_by_camera[c]) times[c].push_back(image->t_ns);
+      if (times[c].empty()) {
+        std::fprintf(stderr, "auvdock: warning: %s: no image of camera %s; it gives no vision\n",
+                     detections_path.c_str(), cameras_[c]->name.c_str());
+      }
+      continue;
+    }
+    if (!dataset.camera_frames.count(cameras_[c]->name)) continue;
     for (const CameraFrame& f : dataset.camera_frames.at(cameras_[c]->name)) {
       by_camera[c].push_back(&f);
     }
     std::stable_sort(by_camera[c].begin(), by_camera[c].end(),
                      [](const CameraFrame* a, const CameraFrame* b) { return a->t_ns < b->t_ns; });
+    for (const CameraFrame* f : by_camera[c]) times[c].push_back(f->t_ns);
   }
-  sync_tolerance_ns_ = sync_tolerance_ns >= 0 ? sync_tolerance_ns : DefaultSyncTolerance(by_camera);
-  // Frames: the earliest unused image and each other camera's next image within the tolerance.
-  std::array<size_t, 3> next{};
-  for (;;) {
-    int64_t t0 = INT64_MAX;
-    for (int c = 0; c < 3; ++c) {
-      if (next[c] < by_camera[c].size()) t0 = std::min(t0, by_camera[c][next[c]]->t_ns);
-    }
-    if (t0 == INT64_MAX) break;
+  sync_tolerance_ns_ = sync_tolerance_ns >= 0 ? sync_tolerance_ns : DefaultSyncTolerance(times);
+  for (const std::array<int, 3>& indices : GroupFrames(times, sync_tolerance_ns_)) {
     FrameImages frame;
-    frame.t_ns = t0;
+    frame.t_ns = INT64_MAX;
     for (int c = 0; c < 3; ++c) {
-      const std::vector<const CameraFrame*>& images = by_camera[c];
-      if (next[c] < images.size() && images[next[c]]->t_ns - t0 <= sync_tolerance_ns_) {
-        frame.images[c] = images[next[c]++];
-        // A repeated time stamp of one camera: its first image is used.
-        while (next[c] < images.size() && images[next[c]]->t_ns == frame.images[c]->t_ns) {
-          ++next[c];
-        }
+      if (indices[c] < 0) continue;
+      const size_t k = static_cast<size_t>(indices[c]);
+      if (detections_path.empty()) {
+        frame.images[c] = by_camera[c][k];
+      } else {
+        frame.detections[c] = replay_by_camera[c][k];
       }
+      frame.t_ns = std::min(frame.t_ns, times[c][k]);
     }
     frames_.push_back(frame);
   }
-  if (frames_.empty()) throw InputError(dataset.root + ": no camera frames");
+  if (frames_.empty()) {
+    if (!detections_path.empty()) {
+      throw InputError(detections_path + ": no image of the calibration's stereo or mono cameras");
+    }
+    const std::string detections = dataset.root + "/detections.csv";
+    throw InputError(dataset.root + ": no camera frames" +
+                     (FileExists(detections)
+                          ? " (it has detections: replay them with --detections " + detections + ")"
+                          : std::string()));
+  }
   for (const std::string& w : pipeline_.warnings()) {
     std::fprintf(stderr, "auvdock: warning: %s\n", w.c_str());
   }
@@ -149,13 +198,15 @@ std::optional<VisionFrame> VisionFrameSource::Next(const Predictor& predict) {
     const AcousticFix& fix = fixes_[next_fix_];
     pipeline_.SetPositionFix(fix.t_ns, fix.p_D, fix.sigma_m, fix_T_B_S_);
   }
+  const std::optional<Pose3> predicted = predict ? predict(t) : std::nullopt;
   const BaselineFrame frame =
-      pipeline_.Process(t, images[0], images[1], images[2], predict ? predict(t) : std::nullopt);
+      replay_.empty() ? pipeline_.Process(t, images[0], images[1], images[2], predicted)
+                      : Replay(group, predicted);
   VisionFrame vision = MakeVisionFrame(frame, cameras_[0], cameras_[1], cameras_[2]);
-  const auto lag = [&](int c) { return group.images[c] ? group.images[c]->t_ns - t : 0; };
+  const auto lag = [&](int c) { return group.image_t_ns(c) - t; };
   vision.stereo_dt_ns = lag(0);
   vision.mono_dt_ns = lag(2);
-  if (group.images[0] && group.images[1] && !warned_unsynchronised_pair_ &&
+  if (group.has(0) && group.has(1) && !warned_unsynchronised_pair_ &&
       std::llabs(lag(0) - lag(1)) > kStereoPairToleranceNs) {
     std::fprintf(stderr,
                  "auvdock: warning: the stereo pair's images at %lld ns are %.1f ms apart; they "
@@ -170,6 +221,41 @@ std::optional<VisionFrame> VisionFrameSource::Next(const Predictor& predict) {
   decode_s_ += Seconds(t1 - t0);
   frontend_s_ += Seconds(Clock::now() - t1);
   return vision;
+}
+
+void VisionFrameSource::ReadReplay(const std::string& path, const Dataset& dataset) {
+  replay_ = ReadDetectionsCsv(path);
+  const DockModel& dock = *dataset.dock;
+  for (const ImageDetections& image : replay_) {
+    const auto where = [&] { return path + ": line " + std::to_string(image.line) + ": "; };
+    if (!dataset.calibration.FindCamera(image.camera)) {
+      throw InputError(where() + "camera '" + image.camera + "' is not in the calibration");
+    }
+    for (int id : image.light_ids) {
+      if (id >= 0 && !dock.FindLight(id)) {
+        throw InputError(where() + "camera '" + image.camera + "' at " +
+                         std::to_string(image.t_ns) + " ns: light " + std::to_string(id) +
+                         " is not a light of the dock");
+      }
+    }
+  }
+}
+
+BaselineFrame VisionFrameSource::Replay(const FrameImages& group,
+                                        const std::optional<Pose3>& predicted) {
+  std::array<std::optional<std::vector<LightDetection>>, 3> detections;
+  std::array<std::vector<int>, 3> ids;
+  for (int c = 0; c < 3; ++c) {
+    if (!group.detections[c]) continue;
+    detections[c] = group.detections[c]->detections;
+    ids[c] = group.detections[c]->light_ids;
+  }
+  GivenIdentities given;
+  given.left = ids[0];
+  given.right = ids[1];
+  given.mono = ids[2];
+  return pipeline_.ProcessDetections(group.t_ns, detections[0], detections[1], detections[2],
+                                     predicted, given);
 }
 
 }  // namespace auvdock::cli

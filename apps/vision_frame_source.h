@@ -3,6 +3,12 @@
 // runs the per-frame vision pipeline (detect, identify, triangulate) into the estimator's
 // VisionFrame. Times decoding and the front-end separately.
 //
+// Replay (`--detections FILE`, io/detections_csv.h): the frames are the file's images instead of
+// the dataset's, grouped the same way; the pipeline identifies their detections
+// (PaperBaselinePipeline::ProcessDetections, with the file's light ids as given identities,
+// checked against the dock) and nothing is decoded. A camera of the file that the calibration
+// does not have, or a light id that the dock does not have, names the file and line.
+//
 // Cameras that are not synchronised with each other: the images of one frame are the earliest
 // image not yet used (at t0) and, of every other camera, its next image within the sync tolerance
 // after t0 (by default half the shortest camera's median frame interval, so each image joins the
@@ -17,10 +23,12 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "auvdock/estimator/vision_frame.h"
 #include "auvdock/io/dataset.h"
+#include "auvdock/io/detections_csv.h"
 #include "auvdock/vision/paper_baseline_pipeline.h"
 
 namespace auvdock::cli {
@@ -32,12 +40,14 @@ int64_t SyncToleranceNs(double milliseconds);
 
 class VisionFrameSource {
  public:
-  // Throws InputError when the dataset has no dock or no camera frames.
+  // Throws InputError when the dataset has no dock or no camera frames (or detections_path,
+  // when given, none), or when detections_path is malformed.
   // sync_tolerance_ns < 0: the default above; 0: only images with equal time stamps share a
-  // frame.
+  // frame. detections_path: replay that detections.csv instead of the images.
   explicit VisionFrameSource(const Dataset& dataset,
                              LightDetectorKind detector = LightDetectorKind::kContrast,
-                             int64_t sync_tolerance_ns = -1);
+                             int64_t sync_tolerance_ns = -1,
+                             const std::string& detections_path = "");
 
   // A body pose T_D_B predicted for a frame time (the estimator's IMU propagation), or nothing.
   using Predictor = std::function<std::optional<Pose3>(int64_t t_ns)>;
@@ -60,16 +70,25 @@ class VisionFrameSource {
   int unreadable_images() const { return unreadable_images_; }
 
  private:
-  // One frame's images: stereo left, stereo right, mono (null: none).
+  // One frame's images: stereo left, stereo right, mono (null: none); in replay, their
+  // detections instead.
   struct FrameImages {
     int64_t t_ns = 0;
     std::array<const CameraFrame*, 3> images{};
+    std::array<const ImageDetections*, 3> detections{};
+    int64_t image_t_ns(int c) const {
+      return images[c] ? images[c]->t_ns : detections[c] ? detections[c]->t_ns : t_ns;
+    }
+    bool has(int c) const { return images[c] || detections[c]; }
   };
+  void ReadReplay(const std::string& path, const Dataset& dataset);
+  BaselineFrame Replay(const FrameImages& group, const std::optional<Pose3>& predicted);
 
   PaperBaselinePipeline pipeline_;
   std::array<const CameraCalibration*, 3> cameras_{};
   int64_t sync_tolerance_ns_ = 0;
   std::vector<FrameImages> frames_;
+  std::vector<ImageDetections> replay_;  // replay: the file's images
   size_t next_ = 0;
   double decode_s_ = 0.0, frontend_s_ = 0.0;
   int unreadable_images_ = 0;

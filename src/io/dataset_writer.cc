@@ -57,6 +57,13 @@ void DatasetWriter::AddVisibility(const VisibilityRecord& r) {
 }
 void DatasetWriter::AddFault(const FaultRecord& f) { faults_->Line(FaultCsvRow(f)); }
 
+void DatasetWriter::AddDetections(const ImageDetections& image) {
+  if (!detections_) {
+    detections_ = std::make_unique<DetectionsCsvWriter>((fs::path(root_) / "detections.csv").string());
+  }
+  detections_->Append(image.t_ns, image.camera, image.detections, image.light_ids);
+}
+
 void DatasetWriter::AddLightTruth(const std::string& camera, int64_t t_ns,
                                       const std::vector<LightTruth>& lights, int width,
                                       int height) {
@@ -109,6 +116,8 @@ void DatasetWriter::Close() {
     if (*w) (*w)->Close();
   }
   for (auto& [name, w] : cameras_) w->Close();
+  for (auto& [name, w] : rendered_lights_) w->Close();
+  if (detections_) detections_->Close();
   tum_.reset();
 }
 

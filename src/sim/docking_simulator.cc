@@ -11,6 +11,7 @@
 #include "auvdock/sim/dvl_simulator.h"
 #include "auvdock/sim/imu_simulator.h"
 #include "auvdock/sim/random_stream.h"
+#include "auvdock/sim/synthetic_detections.h"
 
 namespace auvdock {
 
@@ -88,6 +89,15 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
     camera_rngs.push_back(MakeRandomStream(
         s.seed, static_cast<uint64_t>(RandomStreamId::kCameraBase) + static_cast<uint64_t>(i)));
   }
+  std::vector<SyntheticDetector> detectors;  // without images: each camera's front-end
+  if (!s.cameras.render_images) {
+    for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
+      detectors.emplace_back(
+          s.cameras.synthetic_detections, calibration_.cameras[i], s.dock, noisy,
+          MakeRandomStream(s.seed, static_cast<uint64_t>(RandomStreamId::kSyntheticDetectionsBase) +
+                                       static_cast<uint64_t>(i)));
+    }
+  }
   SimulationSummary summary;
   const int64_t n_imu = SampleCount(s.duration_s, s.imu.rate_hz);
   const int64_t n_depth = SampleCount(s.duration_s, s.depth.rate_hz);
@@ -145,24 +155,30 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
     const VisibilityRecord visibility = VisibilityAt(t);
     writer.AddVisibility(visibility);
     summary.stage_duration_s[static_cast<int>(visibility.stage)] += frame_period_s;
-    if (s.cameras.render_images) {
-      for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
-        const auto& cam = calibration_.cameras[i];
-        // Each camera at its own exposure time (the mono camera may lag the stereo pair).
-        const int64_t t_cam = cam.role == CameraRole::kMono ? t + mono_offset_ns : t;
-        const Pose3 T_D_B = trajectory_.At(Seconds(t_cam)).T_D_B;
-        const RenderResult image = renderers_[i].Render(T_D_B * cam.T_B_C, camera_rngs[i]);
+    for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
+      const auto& cam = calibration_.cameras[i];
+      // Each camera at its own exposure time (the mono camera may lag the stereo pair).
+      const int64_t t_cam = cam.role == CameraRole::kMono ? t + mono_offset_ns : t;
+      const Pose3 T_D_C = trajectory_.At(Seconds(t_cam)).T_D_B * cam.T_B_C;
+      std::vector<RenderedLight> lights;
+      if (s.cameras.render_images) {
+        const RenderResult image = renderers_[i].Render(T_D_C, camera_rngs[i]);
         writer.AddImage(cam.name, t_cam, image.image);
-        std::vector<LightTruth> truth;
-        for (const RenderedLight& light : image.lights) {
-          truth.push_back({light.light_id, light.uv, light.range_m, light.radius_px, light.peak});
-        }
-        writer.AddLightTruth(cam.name, t_cam, truth, cam.intrinsics.width(),
-                                 cam.intrinsics.height());
+        lights = image.lights;
         for (const auto& d : image.distractors) {
           record_fault(FaultRecord{t_cam, cam.name, d.kind, DistractorDetail(d)});
         }
+      } else {
+        lights = renderers_[i].VisibleLights(T_D_C);
+        std::vector<FaultRecord> faults;
+        writer.AddDetections(detectors[i].Detect(t_cam, lights, &faults));
+        for (const FaultRecord& f : faults) record_fault(f);
       }
+      std::vector<LightTruth> truth;
+      for (const RenderedLight& light : lights) {
+        truth.push_back({light.light_id, light.uv, light.range_m, light.radius_px, light.peak});
+      }
+      writer.AddLightTruth(cam.name, t_cam, truth, cam.intrinsics.width(), cam.intrinsics.height());
     }
     ++summary.n_camera_frames;
     if (progress) progress(static_cast<double>(k + 1) / static_cast<double>(n_frames));

@@ -1,5 +1,6 @@
 #include "auvdock/sim/scenario.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -44,6 +45,12 @@ void ReadTrajectory(const ConfigNode& n, DockingTrajectoryConfig* t) {
   if (t->landed_z_D >= 0.0) n.Fail("landed_z_D", "must be above the deck (z < 0)");
 }
 
+double GetProbability(const ConfigNode& n, const std::string& key, double fallback) {
+  const double p = n.GetNonNegative(key, fallback);
+  if (p > 1.0) n.Fail(key, "a probability must lie in [0, 1]");
+  return p;
+}
+
 void ReadCameras(const ConfigNode& n, CameraRigConfig* c) {
   if (n.Has("resolution")) {
     const auto r = n.GetDoubles("resolution");
@@ -65,6 +72,15 @@ void ReadCameras(const ConfigNode& n, CameraRigConfig* c) {
   }
   c->pixel_noise_px = n.GetPositive("pixel_noise_px", c->pixel_noise_px);
   c->render_images = n.GetBool("render_images", c->render_images);
+  const ConfigNode synthetic = n.ChildOrEmpty("synthetic_detections");
+  SyntheticDetectionConfig& d = c->synthetic_detections;
+  d.bias_px = synthetic.GetNonNegative("bias_px", d.bias_px);
+  d.miss_probability = GetProbability(synthetic, "miss_probability", d.miss_probability);
+  d.spurious_per_frame = synthetic.GetNonNegative("spurious_per_frame", d.spurious_per_frame);
+  if (d.spurious_per_frame > 100.0) synthetic.Fail("spurious_per_frame", "at most 100");
+  d.wrong_id_probability =
+      GetProbability(synthetic, "wrong_id_probability", d.wrong_id_probability);
+  d.identified = synthetic.GetBool("identified", d.identified);
   const ConfigNode stereo = n.ChildOrEmpty("stereo");
   c->stereo_baseline_m = stereo.GetPositive("baseline_m", c->stereo_baseline_m);
   c->stereo_tilt_deg = stereo.GetDouble("tilt_deg", c->stereo_tilt_deg);
@@ -98,11 +114,6 @@ void ReadRandomization(const ConfigNode& n, RenderRandomization* r) {
   r->strong_distortion = n.GetBool("strong_distortion", r->strong_distortion);
 }
 
-double GetProbability(const ConfigNode& n, const std::string& key, double fallback) {
-  const double p = n.GetNonNegative(key, fallback);
-  if (p > 1.0) n.Fail(key, "a probability must lie in [0, 1]");
-  return p;
-}
 
 }  // namespace
 
@@ -239,6 +250,17 @@ Calibration MakeCalibration(const Scenario& s) {
   cal.dvl = s.dvl;
   cal.acoustic = s.acoustic;
   return cal;
+}
+
+void ScaleFaultRates(double factor, Scenario* s) {
+  const auto probability = [factor](double p) { return std::min(1.0, factor * p); };
+  s->dvl_faults.gross_error_probability = probability(s->dvl_faults.gross_error_probability);
+  s->dvl_faults.bias_rate_per_min *= factor;
+  s->acoustic_faults.outlier_probability = probability(s->acoustic_faults.outlier_probability);
+  SyntheticDetectionConfig& d = s->cameras.synthetic_detections;
+  d.miss_probability = probability(d.miss_probability);
+  d.spurious_per_frame *= factor;
+  d.wrong_id_probability = probability(d.wrong_id_probability);
 }
 
 }  // namespace auvdock

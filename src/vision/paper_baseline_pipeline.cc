@@ -5,6 +5,7 @@
 #include <limits>
 #include <string>
 
+#include "auvdock/vision/given_identity_check.h"
 #include "auvdock/vision/omnidirectional_matcher.h"
 #include "auvdock/vision/pnp_solver.h"
 #include "auvdock/vision/point_set_alignment.h"
@@ -63,11 +64,27 @@ std::optional<Pose3> PaperBaselinePipeline::Predict(const CameraCalibration& cam
 }
 
 std::optional<Pose3> PaperBaselinePipeline::Identify(const CameraCalibration& camera, int64_t t_ns,
+                                                     const std::vector<int>& given_ids,
                                                      CameraObservation* obs) {
   obs->light_ids.assign(obs->detections.size(), -1);
   MatchResult match;
   std::optional<Pose3> T_C_D;
   const std::optional<Pose3> predicted_T_C_D = Predict(camera, t_ns);
+  if (std::any_of(given_ids.begin(), given_ids.end(), [](int id) { return id >= 0; })) {
+    GivenIdentityCheckOptions check_options;
+    check_options.pixel_noise_px = camera.pixel_noise_px;
+    const GivenIdentityCheck check = CheckGivenIdentities(
+        obs->detections, given_ids, dock_, camera.intrinsics, check_options, predicted_T_C_D);
+    obs->given_dropped = check.dropped;
+    if (check.match.status == MatchStatus::kOk) {
+      obs->given_used = true;
+      obs->status = MatchStatus::kOk;
+      obs->reason.clear();
+      for (const LightMatch& m : check.match.matches) obs->light_ids[m.detection] = m.light_id;
+      return check.T_C_D ? check.T_C_D : predicted_T_C_D;
+    }
+    obs->given_reason = check.match.reason;
+  }
   if (options_.matcher == BaselineMatcher::kOmnidirectional) {
     match = MatchOmnidirectional(obs->detections, dock_);
   } else {
@@ -296,7 +313,7 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
     int64_t t_ns, const std::optional<std::vector<LightDetection>>& left,
     const std::optional<std::vector<LightDetection>>& right,
     const std::optional<std::vector<LightDetection>>& mono,
-    const std::optional<Pose3>& predicted_T_D_B) {
+    const std::optional<Pose3>& predicted_T_D_B, const GivenIdentities& given) {
   external_T_D_B_ = predicted_T_D_B;
   BaselineFrame frame;
   frame.t_ns = t_ns;
@@ -305,10 +322,10 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
   if (have_stereo) {
     frame.left.detections = *left;
     frame.right.detections = *right;
-    std::optional<Pose3> T_C_D = Identify(*left_, t_ns, &frame.left);
+    std::optional<Pose3> T_C_D = Identify(*left_, t_ns, given.left, &frame.left);
     const bool left_identified = frame.left.status == MatchStatus::kOk;
     if (!left_identified) {
-      T_C_D = Identify(*right_, t_ns, &frame.right);
+      T_C_D = Identify(*right_, t_ns, given.right, &frame.right);
     } else {
       frame.right.status = MatchStatus::kOk;
     }
@@ -316,7 +333,7 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
   }
   if (have_mono) {
     frame.mono.detections = *mono;
-    Identify(*mono_, t_ns, &frame.mono);
+    Identify(*mono_, t_ns, given.mono, &frame.mono);
     if (frame.mono.status == MatchStatus::kOk) MonoPose(Predict(*mono_, t_ns), &frame);
   }
 

@@ -13,6 +13,7 @@
 #include "auvdock/geometry/dock_model.h"
 #include "auvdock/io/calibration.h"
 #include "auvdock/io/csv.h"
+#include "auvdock/io/detections_csv.h"
 #include "auvdock/io/measurements.h"
 #include "auvdock/io/tum_io.h"
 
@@ -39,6 +40,9 @@ class DatasetWriter {
   void AddGroundTruth(const GroundTruthState& s);  // also appends to groundtruth.tum
   void AddVisibility(const VisibilityRecord& r);
   void AddFault(const FaultRecord& f);
+  // Appends one image's detections to detections.csv (io/detections_csv.h), created on the
+  // first call: the synthetic front-end's output (`cameras.render_images: false`).
+  void AddDetections(const ImageDetections& image);
   void Close();
 
   const std::string& root() const { return root_; }
@@ -49,6 +53,7 @@ class DatasetWriter {
   std::unique_ptr<TumWriter> tum_;
   std::map<std::string, std::unique_ptr<CsvWriter>> cameras_;
   std::map<std::string, std::unique_ptr<CsvWriter>> rendered_lights_;
+  std::unique_ptr<DetectionsCsvWriter> detections_;
 };
 
 }  // namespace auvdock

@@ -22,6 +22,7 @@ enum class RandomStreamId : uint64_t {
   kLensBase = 50,         // + camera index: the randomised distortion
   kCameraBase = 100,  // + camera index
   kRenderLookBase = 200,  // + camera index: the randomised look
+  kSyntheticDetectionsBase = 300,  // + camera index: the synthetic front-end's errors
 };
 
 std::mt19937_64 MakeRandomStream(uint64_t seed, uint64_t stream_id);

@@ -16,6 +16,7 @@
 #include "auvdock/sim/docking_trajectory.h"
 #include "auvdock/sim/dvl_simulator.h"
 #include "auvdock/sim/render_look.h"
+#include "auvdock/sim/synthetic_detections.h"
 #include "auvdock/sim/underwater_renderer.h"
 #include "auvdock/sim/water_model.h"
 
@@ -35,7 +36,10 @@ struct CameraRigConfig {
   // Cameras not synchronised with each other: the mono camera's frames are this long after the
   // stereo pair's (s, in [0, 1 / rate_hz)); 0 = one trigger for all three.
   double mono_time_offset_s = 0.0;
+  // false: no images; each camera's detections are drawn instead (sim/synthetic_detections.h)
+  // into detections.csv, for `run` / `smooth --detections` (seconds instead of a minute).
   bool render_images = true;
+  SyntheticDetectionConfig synthetic_detections;  // key synthetic_detections
 };
 
 struct Scenario {
@@ -71,5 +75,11 @@ Scenario LoadScenario(const std::string& path);
 // The calibration of the simulated rig (what the dataset's calibration.yaml holds). With
 // randomize.strong_distortion, each camera's distortion is drawn from the seed (render_look.h).
 Calibration MakeCalibration(const Scenario& scenario);
+
+// Multiplies every fault rate by factor (>= 0; probabilities clamped to 1): DVL spikes and
+// bias episodes, acoustic outliers, and the synthetic front-end's misses, spurious blobs and
+// wrong ids (`simulate --fault-scale`, the Monte-Carlo audit's "several times the default").
+// The sizes of the faults and the image renderer's distractors are unchanged.
+void ScaleFaultRates(double factor, Scenario* scenario);
 
 }  // namespace auvdock

@@ -14,6 +14,11 @@
 //   4. kOk with the kept claims (MatchResult::matches, cost = RMS residual px) and T_C_D, or
 //      kFailed with the reason ("the given identities do not fit the dock: ..."): the caller
 //      then identifies the image itself, ignoring the claims.
+// A planar layout seen nearly head-on has two PnP minima that fit about equally (SolvePnp step
+// 2b): the better one still tests the claims, but no T_C_D is returned (the pose is not known
+// from these pixels). With 3 claims and a prediction the fit has no redundancy (6 residuals,
+// 6 unknowns): such claims pass unchecked here, and the estimator's chi-square gate against
+// its prediction is their test.
 // Frames: D dock, C camera (OpenCV); pixels in the raw (distorted) image.
 #pragma once
 

@@ -9,7 +9,9 @@
 //      selectable), the other stereo image inherits the identities through left-right matching
 //      on the epipolar line (MatchStereoDetections, seed 004), checked against its own
 //      identification by prediction from the identified camera's pose (MatchByPrediction through
-//      the rig's extrinsics): a pair is used only when both give the same light;
+//      the rig's extrinsics): a pair is used only when both give the same light. Identities
+//      given with the detections (ProcessDetections' GivenIdentities: a front-end of the
+//      user's) replace the matcher for an image when they fit the dock (CheckGivenIdentities);
 //   3. stereo pose: triangulate the identified pairs (TriangulateLinear, eqs. 11-16) in the left
 //      camera frame S and align them to the dock lights by SVD (AlignPointSets, eqs. 17-23):
 //      T_D_S, then T_D_B = T_D_S T_B_S^-1 (S is cam0). The aligned pose is kept only if it
@@ -140,7 +142,21 @@ struct CameraObservation {
   bool tracked = false;  // identified by prediction (tracking) rather than from scratch
   int guided = 0;        // detections added by the second look (steps 6, 7), at the end
   int by_estimate = 0;   // lights identified by the estimate alone (step 7)
+  // Identities given with the detections (GivenIdentities): used (they fit the dock), and how
+  // many claims were left out; or why they were not used (then the image was identified here).
+  bool given_used = false;
+  int given_dropped = 0;
+  std::string given_reason;
   int num_identified() const;
+};
+
+// Identities that a front-end reported with its detections (detections.csv's light_id), per
+// camera and aligned with that camera's detections: the dock light id, or -1. Empty: none given.
+// They are checked against the dock (CheckGivenIdentities) and, if they fit, replace step 2's
+// identification of that image; otherwise the image is identified as usual. A symmetric dock's
+// given identities are taken as they are: the front-end has chosen among its rival poses.
+struct GivenIdentities {
+  std::vector<int> left, right, mono;
 };
 
 struct BaselineFrame {
@@ -175,12 +191,13 @@ class PaperBaselinePipeline {
                         const std::optional<Pose3>& predicted_T_D_B = std::nullopt);
 
   // Steps 2-5 on detections made elsewhere (Process = LightDetector::Detect on each image, then
-  // this); std::nullopt for an absent camera or image.
+  // this); std::nullopt for an absent camera or image. given: identities reported with them.
   BaselineFrame ProcessDetections(int64_t t_ns,
                                   const std::optional<std::vector<LightDetection>>& left,
                                   const std::optional<std::vector<LightDetection>>& right,
                                   const std::optional<std::vector<LightDetection>>& mono,
-                                  const std::optional<Pose3>& predicted_T_D_B = std::nullopt);
+                                  const std::optional<Pose3>& predicted_T_D_B = std::nullopt,
+                                  const GivenIdentities& given = {});
 
   const CameraCalibration* left_camera() const { return left_; }
   const CameraCalibration* right_camera() const { return right_; }
@@ -195,9 +212,10 @@ class PaperBaselinePipeline {
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
-  // Identifies the detections of one image against the dock; returns the matcher's pose.
+  // Identifies the detections of one image against the dock, by the given identities when they
+  // fit it, else by the matcher; returns the pose of the identification.
   std::optional<Pose3> Identify(const CameraCalibration& camera, int64_t t_ns,
-                                CameraObservation* obs);
+                                const std::vector<int>& given_ids, CameraObservation* obs);
   // T_I_D_identified: the pose of the identified stereo camera (left if left_identified).
   void StereoPose(bool left_identified, const std::optional<Pose3>& T_I_D_identified,
                   BaselineFrame* frame);

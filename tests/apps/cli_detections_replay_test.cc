@@ -1,0 +1,127 @@
+// End-to-end: `simulate --detections-only` writes detections.csv instead of images, and `run` /
+// `smooth --detections` replay it through the estimator; `frontend`'s own detections.csv
+// replays too; a detections file that does not fit the calibration or the dock is one line,
+// exit 2, naming the file and line.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "auvdock/io/detections_csv.h"
+#include "auvdock/io/tum_io.h"
+#include "tests/testing/run_command.h"
+#include "tests/testing/temp_dir.h"
+#include "tests/testing/test_scenarios.h"
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+namespace auvdock {
+namespace {
+
+class DetectionsReplayCli : public ::testing::Test {
+ protected:
+  // 12 s of the default scenario from its start: the stereo approach and the first mono frames.
+  static void SetUpTestSuite() {
+    tmp_ = new test::TempDir();
+    dataset_ = *tmp_ / "ds";
+    const std::string scenario = *tmp_ / "s.yaml";
+    test::WriteTextFile(scenario, "name: short\nduration_s: 12.0\ndock: " +
+                                      test::SourcePath("data/docks/t_shape.yaml") + "\n");
+    const auto r = test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset_,
+                                     "--detections-only", "--quiet"});
+    ASSERT_EQ(r.exit_status, 0) << r.err;
+  }
+  static void TearDownTestSuite() { delete tmp_; }
+  static test::TempDir* tmp_;
+  static std::string dataset_;
+};
+test::TempDir* DetectionsReplayCli::tmp_ = nullptr;
+std::string DetectionsReplayCli::dataset_;
+
+TEST_F(DetectionsReplayCli, SimulateWritesDetectionsAndNoImages) {
+  for (const char* camera : {"cam0", "cam1", "cam2"}) {
+    const fs::path images = fs::path(dataset_) / camera / "data";
+    EXPECT_TRUE(!fs::exists(images) || fs::is_empty(images)) << camera;
+  }
+  const std::vector<ImageDetections> images = ReadDetectionsCsv(dataset_ + "/detections.csv");
+  // 121 frames x 3 cameras, each image listed (with detections or as "saw nothing").
+  EXPECT_EQ(images.size(), 3u * 121u);
+  int identified = 0;
+  for (const ImageDetections& image : images) {
+    for (int id : image.light_ids) identified += id >= 0 ? 1 : 0;
+  }
+  EXPECT_GT(identified, 1000);
+  EXPECT_THAT(test::ReadTextFile(dataset_ + "/groundtruth/faults.csv"), HasSubstr("missed_light"));
+}
+
+TEST_F(DetectionsReplayCli, RunAndSmoothReplayTheDetections) {
+  for (const std::string command : {"run", "smooth"}) {
+    const std::string out = *tmp_ / (command + "_out");
+    const auto r = test::RunAuvdock({command, "--dataset", dataset_, "--detections",
+                                     dataset_ + "/detections.csv", "--out", out, "--quiet"});
+    ASSERT_EQ(r.exit_status, 0) << command << ": " << r.err;
+    EXPECT_GE(ReadTumTrajectory(out + "/trajectory.tum").size(), 110u) << command;
+    const auto e = test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate",
+                                     out + "/trajectory.tum", "--covariance",
+                                     out + "/covariance.csv", "--json"});
+    ASSERT_EQ(e.exit_status, 0) << e.err;
+    const nlohmann::json report = nlohmann::json::parse(e.out);
+    // Stereo at 4-10 m: a sanity bound (the image path's own test uses 0.3 m on 3 s).
+    EXPECT_LT(report.at("pos_rmse_m").get<double>(), 0.1) << command;
+  }
+}
+
+TEST_F(DetectionsReplayCli, ADatasetWithoutImagesPointsToTheDetections) {
+  const auto r = test::RunAuvdock({"run", "--dataset", dataset_, "--out", *tmp_ / "no_images"});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_THAT(r.err, HasSubstr("--detections"));
+}
+
+TEST_F(DetectionsReplayCli, DetectionsThatDoNotFitAreOneLineExitTwo) {
+  const std::string header =
+      "#timestamp_ns,camera,light_id,u,v,radius,score\n"
+      "1700000000000000000,cam0,1,100,100,2,1\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"1700000000100000000,cam7,1,100,100,2,1\n", "camera 'cam7' is not in the calibration"},
+      {"1700000000100000000,cam0,42,100,100,2,1\n", "light 42 is not a light of the dock"},
+      {"1700000000100000000,cam0,1,100,x,2,1\n", "column 'v'"},
+  };
+  int k = 0;
+  for (const auto& [row, expected] : cases) {
+    const std::string file = *tmp_ / ("bad" + std::to_string(k) + ".csv");
+    const std::string out = *tmp_ / ("bad_out" + std::to_string(k++));
+    test::WriteTextFile(file, header + row);
+    const auto r = test::RunAuvdock(
+        {"run", "--dataset", dataset_, "--detections", file, "--out", out, "--quiet"});
+    EXPECT_EQ(r.exit_status, 2) << row;
+    EXPECT_THAT(r.err, HasSubstr(file + ": line 3")) << r.err;
+    EXPECT_THAT(r.err, HasSubstr(expected)) << r.err;
+    EXPECT_FALSE(fs::exists(out + "/trajectory.tum")) << row;
+  }
+}
+
+TEST(FrontendDetectionsReplayCli, FrontendDetectionsReplayThroughRun) {
+  test::TempDir tmp;
+  const std::string scenario = tmp / "s.yaml";
+  test::WriteTextFile(scenario, "name: short\nduration_s: 2.0\ndock: " +
+                                    test::SourcePath("data/docks/t_shape.yaml") + "\n");
+  const std::string ds = tmp / "ds", fe = tmp / "fe", out = tmp / "run";
+  ASSERT_EQ(test::RunAuvdock({"simulate", "--scenario", scenario, "--out", ds, "--quiet"})
+                .exit_status,
+            0);
+  ASSERT_EQ(test::RunAuvdock({"frontend", "--dataset", ds, "--out", fe, "--quiet"}).exit_status,
+            0);
+  // Every image of the 21 frames is in the file, including those that saw nothing.
+  EXPECT_EQ(ReadDetectionsCsv(fe + "/detections.csv").size(), 3u * 21u);
+  const auto r = test::RunAuvdock(
+      {"run", "--dataset", ds, "--detections", fe + "/detections.csv", "--out", out, "--quiet"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_GE(ReadTumTrajectory(out + "/trajectory.tum").size(), 15u);
+}
+
+}  // namespace
+}  // namespace auvdock
