@@ -48,11 +48,11 @@ DvlRateVerdict DvlRateTest::Check(const DvlMeasurement& sample, const ImuBuffer&
   if (verdict.pass) {
     candidate_ = Reference{sample, w_B, true};
   } else if (!reference_->confirmed) {
-    // Against a reference that never passed itself the test has no opinion: the gate decides,
-    // and what it keeps becomes the reference.
-    verdict.pass = true;
+    // Two samples that disagree, the older never tested itself: either may be the spike, so
+    // neither is trusted. The newer one is rejected and waits, as the reference, for a sample
+    // that agrees with it.
+    verdict.reason = "rate test: disagrees with the previous sample, itself untested";
     become_reference(false);
-    candidate_ = Reference{sample, w_B, true};
   } else {
     verdict.reason = "rate test: jump against the IMU since the last good sample";
   }

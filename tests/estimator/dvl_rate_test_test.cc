@@ -78,20 +78,42 @@ TEST_F(DvlRateTestTest, ALongSmallBiasFailsWhileTheReferenceIsYoung) {
   EXPECT_TRUE(Check(&test, Sample(20)).pass);  // back to normal: the reference held
 }
 
-// A spike as the very first sample does not lock the test: the next clean sample has no
-// confirmed reference to fail against, passes to the gate, and once kept is the reference.
+// A spike as the very first sample does not lock the test: the next clean sample disagrees
+// with it and is rejected in its place as the untested reference, the one after agrees with it
+// and passes, and once kept is the reference.
 TEST_F(DvlRateTestTest, ASpikeFirstDoesNotLockTheTest) {
   DvlRateTest test(calibration_, DvlRateTestOptions());
   EXPECT_FALSE(Check(&test, Sample(0, Eigen::Vector3d(0.5, 0.0, 0.0))).pass);
-  const DvlMeasurement second = Sample(1);
-  EXPECT_TRUE(Check(&test, second).pass);  // no opinion against an unconfirmed reference
-  test.Confirm(second.t_ns);
+  const DvlRateVerdict second = Check(&test, Sample(1));
+  EXPECT_FALSE(second.pass);
+  EXPECT_EQ(second.reason, "rate test: disagrees with the previous sample, itself untested");
   for (int k = 2; k < 10; ++k) {
     const DvlMeasurement m = Sample(k);
     EXPECT_TRUE(Check(&test, m).pass) << k;
     test.Confirm(m.t_ns);
   }
   EXPECT_FALSE(Check(&test, Sample(10, Eigen::Vector3d(0.0, 0.0, 0.3))).pass);
+}
+
+// A spike right after the first sample is rejected, not passed to the gate (which at a start
+// has no other velocity to hold it against and would keep it as the reference that rejects
+// every clean sample after it); two clean samples later the test passes clean samples again.
+TEST_F(DvlRateTestTest, ASpikeSecondIsNotLetThrough) {
+  DvlRateTest test(calibration_, DvlRateTestOptions());
+  EXPECT_FALSE(Check(&test, Sample(0)).pass);
+  const DvlMeasurement spike = Sample(1, Eigen::Vector3d(-0.17, 0.28, -0.17));
+  EXPECT_FALSE(Check(&test, spike).pass);
+  test.Confirm(spike.t_ns);  // a gate's word cannot make it the reference: it was rejected
+  EXPECT_FALSE(Check(&test, Sample(2)).pass);  // disagrees with the untested spike
+  int passed = 0;
+  for (int k = 3; k < 20; ++k) {
+    const DvlMeasurement m = Sample(k);
+    if (Check(&test, m).pass) {
+      ++passed;
+      test.Confirm(m.t_ns);
+    }
+  }
+  EXPECT_GE(passed, 16);
 }
 
 // An unconfirmed candidate (the gate did not keep it) is not the next reference; a reference
