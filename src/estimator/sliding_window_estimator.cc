@@ -124,6 +124,7 @@ bool SlidingWindowEstimator::Initialize(const VisionFrame& frame) {
   symmetry_unresolved_ = frame.symmetry_unresolved;
   auto state = std::make_unique<State>();
   state->t_ns = frame.t_ns;
+  first_state_t_ns_ = frame.t_ns;
   PoseToBlock(*frame.T_D_B_initial, state->pose);
   problem_->AddParameterBlock(state->pose, kPoseSize, pose_manifold_.get());
   problem_->AddParameterBlock(state->velocity, kVelocitySize);
@@ -281,7 +282,7 @@ SlidingWindowEstimator::State* SlidingWindowEstimator::StateFor(int64_t t_ns,
   auto it = std::find_if(window_.rbegin(), window_.rend(),
                          [&](const std::unique_ptr<State>& s) { return s->t_ns <= t_ns; });
   if (it != window_.rend()) return it->get();
-  if (!window_.empty() &&
+  if (!window_.empty() && t_ns >= first_state_t_ns_ &&
       window_.front()->t_ns - t_ns <= static_cast<int64_t>(max_before_s * kNsPerSecond)) {
     return window_.front().get();
   }
@@ -305,7 +306,9 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachPending(std::deque<Sam
       added.push_back({*id, sample.t_ns});
     } else {
       ++*skipped;
-      rejections_.push_back({sample.t_ns, sensor, kNoStatistic, kNoStateReason});
+      rejections_.push_back({sample.t_ns, sensor, kNoStatistic,
+                             sample.t_ns < first_state_t_ns_ ? kBeforeFirstStateReason
+                                                             : kNoStateReason});
     }
   }
   return added;

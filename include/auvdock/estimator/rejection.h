@@ -22,5 +22,8 @@ inline constexpr double kNoStatistic = std::numeric_limits<double>::quiet_NaN();
 // The reason of a sensor sample that found no state to attach to.
 inline constexpr const char* kNoStateReason =
     "no state at or before its time or the IMU does not reach it";
+// ... of one from before the sliding window's first state since its last initialisation.
+inline constexpr const char* kBeforeFirstStateReason =
+    "before the estimator's first state (it initialised after this sample)";
 
 }  // namespace auvdock

@@ -142,7 +142,12 @@ struct EstimatorOptions {
   UsblRateTestOptions usbl_rate_test;  // seed 001's rate-of-change test (usbl_rate_test.h)
   // A fix arrives late (AcousticFix::latency_ns); one whose time has already left the window by
   // up to this much attaches to the oldest state through the IMU shifted backward
-  // (factors/time_shifted_factor.h); an older one is rejected ("no state").
+  // (factors/time_shifted_factor.h); an older one is rejected ("no state"). A fix from before
+  // the estimator's first state (measured before it initialised, or before a reset) is rejected
+  // too: shifted back from a fresh state, whose velocity only its loose prior holds, it would be
+  // absorbed by the velocity and pass its gate however wrong it is (an outlier fix measured
+  // before initialisation and arriving after it caused 5 of the 7 Monte-Carlo runs with unsafe
+  // GO, README).
   double usbl_max_backward_shift_s = 1.0;
   // Multiplies the calibration's IMU noise densities and random walks (sigma, not variance).
   // Datasheet values are measured on a bench, at constant temperature, without vibration; on a
@@ -277,7 +282,8 @@ class SlidingWindowEstimator {
   // The state's blocks for the measurement factors (estimator/state_blocks.h).
   StateBlocks BlocksOf(State& state) const;
   // The state a measurement at t_ns attaches to: the newest at or before it, else the oldest
-  // when t_ns is at most max_before_s before it (a late measurement), else none.
+  // when t_ns is at most max_before_s before it (a late measurement) and not before the first
+  // state since the last initialisation, else none.
   State* StateFor(int64_t t_ns, double max_before_s = 0.0);
   EstimatorOutput Output(const State& state);
   // The newest frame's vision residuals, with their leverage on the newest pose (its covariance
@@ -307,6 +313,7 @@ class SlidingWindowEstimator {
   int64_t last_dvl_sample_t_ns_ = INT64_MIN;
   int64_t last_usbl_sample_t_ns_ = INT64_MIN;
   int64_t last_frame_t_ns_ = INT64_MIN;
+  int64_t first_state_t_ns_ = INT64_MIN;  // since the last initialisation
   int64_t last_vision_t_ns_ = INT64_MIN;
   bool symmetry_unresolved_ = false;  // of the window's first pose (EstimatorOutput)
   int64_t last_dvl_t_ns_ = INT64_MIN;
