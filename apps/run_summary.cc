@@ -40,6 +40,11 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                            {"rate_test_rejected", stats.usbl_rate_rejected},
                            {"skipped", stats.usbl_skipped}};
   summary["no_vision_reasons"] = source.no_vision_reasons();
+  if (source.replaying()) {
+    const VisionFrameSource::GivenIdentityCounts& given = source.given_identities();
+    summary["given_identities"] = {
+        {"used", given.used}, {"dropped", given.dropped}, {"refused", given.refused}};
+  }
   summary["warnings"] = source.warnings();
   summary["adaptive_variance_factor"] = {{"mono", stats.mono_variance_factor},
                                          {"stereo", stats.stereo_variance_factor},
@@ -69,6 +74,19 @@ void PrintSymmetryUnresolved(const char* command, int count) {
               "rival poses apart (give dock.yaml approach_direction_D, or acoustic fixes); they "
               "are NO-GO\n",
               command, count);
+}
+
+void PrintGivenIdentities(const VisionFrameSource& source) {
+  if (!source.replaying()) return;
+  const VisionFrameSource::GivenIdentityCounts& given = source.given_identities();
+  int refused = 0;
+  for (const auto& [reason, count] : given.refused) refused += count;
+  if (given.used == 0 && refused == 0) return;  // the file gave no identities
+  std::printf("  given identities: used in %d images (%d claims left out), refused in %d\n",
+              given.used, given.dropped, refused);
+  for (const auto& [reason, count] : given.refused) {
+    std::printf("    refused: %d images: %s\n", count, reason.c_str());
+  }
 }
 
 }  // namespace auvdock::cli

@@ -1,7 +1,8 @@
 // summary.json of `auvdock run` / `auvdock smooth`: counts of frames, estimates, GO decisions,
 // skipped measurements (with the log of what was skipped and every reset), and the time spent:
 // data_duration_s and timing_s {decode, frontend, backend, total}, plus the speed as a multiple
-// of real time with and without decoding and for the back-end alone.
+// of real time with and without decoding and for the back-end alone. In replay
+// (--detections), given_identities {used, dropped, refused: {reason: images}}.
 #pragma once
 
 #include <string>
@@ -26,6 +27,9 @@ struct RunCounters {
 
 // One line on stdout when some estimates are known only up to the dock's symmetry.
 void PrintSymmetryUnresolved(const char* command, int count);
+
+// In replay, what became of the identities given with the detections (nothing when none were).
+void PrintGivenIdentities(const VisionFrameSource& source);
 
 nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorStats& stats,
                               const std::vector<std::string>& skipped_rows,

@@ -146,6 +146,7 @@ void Smooth(const SmoothOptions& options) {
     std::printf("  no vision: %d frames: %s\n", count, reason.c_str());
   }
   PrintSymmetryUnresolved("smooth", counters.symmetry_unresolved);
+  PrintGivenIdentities(source);
 }
 
 }  // namespace

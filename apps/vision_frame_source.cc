@@ -127,14 +127,15 @@ VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind d
     });
     fix_T_B_S_ = dataset.calibration.acoustic->T_B_S;
   }
-  if (!detections_path.empty()) ReadReplay(detections_path, dataset);
+  replaying_ = !detections_path.empty();
+  if (replaying_) ReadReplay(detections_path, dataset);
   // Each camera's images (or, in replay, its images' detections), in time order.
   std::array<std::vector<const CameraFrame*>, 3> by_camera;
   std::array<std::vector<const ImageDetections*>, 3> replay_by_camera;
   std::array<std::vector<int64_t>, 3> times;
   for (int c = 0; c < 3; ++c) {
     if (!cameras_[c]) continue;
-    if (!detections_path.empty()) {
+    if (replaying_) {
       for (const ImageDetections& image : replay_) {
         if (image.camera == cameras_[c]->name) replay_by_camera[c].push_back(&image);
       }
@@ -160,7 +161,7 @@ VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind d
     for (int c = 0; c < 3; ++c) {
       if (indices[c] < 0) continue;
       const size_t k = static_cast<size_t>(indices[c]);
-      if (detections_path.empty()) {
+      if (!replaying_) {
         frame.images[c] = by_camera[c][k];
       } else {
         frame.detections[c] = replay_by_camera[c][k];
@@ -170,7 +171,7 @@ VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind d
     frames_.push_back(frame);
   }
   if (frames_.empty()) {
-    if (!detections_path.empty()) {
+    if (replaying_) {
       throw InputError(detections_path + ": no image of the calibration's stereo or mono cameras");
     }
     const std::string detections = dataset.root + "/detections.csv";
@@ -200,8 +201,8 @@ std::optional<VisionFrame> VisionFrameSource::Next(const Predictor& predict) {
   }
   const std::optional<Pose3> predicted = predict ? predict(t) : std::nullopt;
   const BaselineFrame frame =
-      replay_.empty() ? pipeline_.Process(t, images[0], images[1], images[2], predicted)
-                      : Replay(group, predicted);
+      replaying_ ? Replay(group, predicted)
+                 : pipeline_.Process(t, images[0], images[1], images[2], predicted);
   VisionFrame vision = MakeVisionFrame(frame, cameras_[0], cameras_[1], cameras_[2]);
   const auto lag = [&](int c) { return group.image_t_ns(c) - t; };
   vision.stereo_dt_ns = lag(0);
@@ -254,8 +255,17 @@ BaselineFrame VisionFrameSource::Replay(const FrameImages& group,
   given.left = ids[0];
   given.right = ids[1];
   given.mono = ids[2];
-  return pipeline_.ProcessDetections(group.t_ns, detections[0], detections[1], detections[2],
-                                     predicted, given);
+  BaselineFrame frame = pipeline_.ProcessDetections(group.t_ns, detections[0], detections[1],
+                                                    detections[2], predicted, given);
+  for (const CameraObservation* obs : {&frame.left, &frame.right, &frame.mono}) {
+    given_.dropped += obs->given_dropped;
+    if (obs->given_used) {
+      ++given_.used;
+    } else if (!obs->given_reason.empty()) {
+      ++given_.refused[ReasonClass(obs->given_reason)];
+    }
+  }
+  return frame;
 }
 
 }  // namespace auvdock::cli

@@ -60,6 +60,14 @@ class VisionFrameSource {
   const std::vector<std::string>& warnings() const { return pipeline_.warnings(); }
   // Frames that gave the estimator no vision, counted by the pipeline's reason.
   const std::map<std::string, int>& no_vision_reasons() const { return no_vision_reasons_; }
+  // Replay only: what became of the identities given with the detections, per camera image.
+  struct GivenIdentityCounts {
+    int used = 0;     // images whose given identities fit the dock and were used
+    int dropped = 0;  // single claims left out of otherwise used identities
+    std::map<std::string, int> refused;  // images identified afresh instead, by the reason
+  };
+  bool replaying() const { return replaying_; }
+  const GivenIdentityCounts& given_identities() const { return given_; }
 
   size_t num_frames() const { return frames_.size(); }
   int64_t first_t_ns() const { return frames_.front().t_ns; }
@@ -88,7 +96,9 @@ class VisionFrameSource {
   std::array<const CameraCalibration*, 3> cameras_{};
   int64_t sync_tolerance_ns_ = 0;
   std::vector<FrameImages> frames_;
+  bool replaying_ = false;               // detections.csv instead of the images
   std::vector<ImageDetections> replay_;  // replay: the file's images
+  GivenIdentityCounts given_;
   size_t next_ = 0;
   double decode_s_ = 0.0, frontend_s_ = 0.0;
   int unreadable_images_ = 0;

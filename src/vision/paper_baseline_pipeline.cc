@@ -201,7 +201,10 @@ void PaperBaselinePipeline::StereoPose(bool left_identified,
   }
   // The aligned pose must put every used light back onto its detection in both images: a wrong
   // identity cannot be aligned rigidly with the others and shows up here. Refuse rather than
-  // report a wrong pose (and withdraw the transferred identities, which the estimator reads).
+  // report a wrong pose. Identities transferred by left-right matching are withdrawn (the
+  // estimator reads them); identities the partner image got from its own prediction-gated match
+  // stay: they were checked against the whole pattern in that image, and an SVD pose that
+  // misses by a few pixels at long range says more about the triangulated depths than about them.
   const Pose3 T_L_D = aligned.T_dst_src.Inverse();
   const Pose3 T_R_D = right_->T_B_C.Inverse() * left_->T_B_C * T_L_D;
   double worst_px = 0.0;
@@ -216,7 +219,7 @@ void PaperBaselinePipeline::StereoPose(bool left_identified,
                          (*uv_r - frame->right.detections[used[k].second].uv).norm()});
   }
   if (!(worst_px <= options_.max_stereo_reprojection_px)) {
-    partner.light_ids.assign(partner.detections.size(), -1);
+    if (!partner_predicted) partner.light_ids.assign(partner.detections.size(), -1);
     frame->reason = "stereo: the aligned pose reprojects " + std::to_string(worst_px) +
                     " px from a light (identities inconsistent)";
     return;
