@@ -9,7 +9,7 @@ namespace auvdock::cli {
 
 inline std::string ReasonClass(const std::string& reason) {
   std::string key = reason.substr(0, reason.find_first_of("0123456789({"));
-  while (!key.empty() && (key.back() == ' ' || key.back() == ',')) key.pop_back();
+  while (!key.empty() && (key.back() == ' ' || key.back() == ',' || key.back() == ':')) key.pop_back();
   return key.empty() ? reason : key;
 }
 

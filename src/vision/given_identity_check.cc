@@ -102,7 +102,7 @@ GivenIdentityCheck CheckGivenIdentities(const std::vector<LightDetection>& detec
   // 2. PnP on the claims.
   const int min_lights = predicted_T_C_D ? std::min(3, options.min_lights) : options.min_lights;
   if (static_cast<int>(claims.size()) < min_lights) {
-    return Failed(std::to_string(claims.size()) + " claimed lights, " +
+    return Failed("too few claimed lights: " + std::to_string(claims.size()) + ", " +
                       std::to_string(min_lights) + " needed",
                   dropped);
   }

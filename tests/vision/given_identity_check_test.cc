@@ -90,7 +90,7 @@ TEST_F(GivenIdentityCheckTest, ClaimsThatCannotBeRightFail) {
   const GivenIdentityCheck too_few =
       CheckGivenIdentities(view.detections, few, dock_, camera_, {}, std::nullopt);
   EXPECT_EQ(too_few.match.status, MatchStatus::kFailed);
-  EXPECT_NE(too_few.match.reason.find("2 claimed lights, 4 needed"), std::string::npos)
+  EXPECT_NE(too_few.match.reason.find("too few claimed lights: 2, 4 needed"), std::string::npos)
       << too_few.match.reason;
   // Every identity shifted by one: no pose fits them.
   std::vector<int> shifted = view.truth;
