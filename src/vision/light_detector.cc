@@ -613,8 +613,10 @@ FitSamples CollectSamples(const cv::Mat& image, int channel, int cx, int cy, int
   if (x0 > x1 || y0 > y1) return samples;
   const double area = static_cast<double>(x1 - x0 + 1) * (y1 - y0 + 1);
   const int stride = std::max(1, static_cast<int>(std::ceil(std::sqrt(area / max_pixels))));
-  const int xs = cx - ((cx - x0) / stride) * stride;
-  const int ys = cy - ((cy - y0) / stride) * stride;
+  // The first grid column and row inside the window (cx, cy may lie outside it when the light's
+  // centre is off the image: the remainder must then be taken towards +infinity, not 0).
+  const int xs = x0 + (((cx - x0) % stride) + stride) % stride;
+  const int ys = y0 + (((cy - y0) % stride) + stride) % stride;
   const int channels = image.channels();
   const size_t capacity = static_cast<size_t>(area / (stride * stride)) + 4 + kFitLanes;
   samples.x.reserve(capacity);
