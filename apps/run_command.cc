@@ -77,8 +77,9 @@ void Run(const RunOptions& options) {
         writer.Write(*out, decision);
       } else {
         writer.WriteNoEstimate(frame->t_ns, go_no_go.NoEstimate(
-                                                estimator.initialized()
-                                                    ? "estimator reset"
+                                                estimator.initialized() ? "estimator reset"
+                                                : !estimator.init_refusal().empty()
+                                                    ? "not initialised (" + estimator.init_refusal() + ")"
                                                     : "not initialised (waiting for a per-frame pose)"));
       }
       const std::vector<std::string>& log = estimator.stats().log;

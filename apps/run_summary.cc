@@ -51,6 +51,7 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                                          {"dvl", stats.dvl_variance_factor},
                                          {"depth", stats.depth_variance_factor}};
   summary["resets"] = stats.resets;
+  summary["init_refused"] = stats.init_refused;
   summary["solver_failures"] = stats.solver_failures;
   summary["covariance_failures"] = stats.covariance_failures;
   summary["data_duration_s"] = data_duration_s;

@@ -58,6 +58,9 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.init_velocity_sigma_mps = est.GetPositive("init_velocity_sigma_mps", e.init_velocity_sigma_mps);
   e.init_gyro_bias_sigma = est.GetPositive("init_gyro_bias_sigma", e.init_gyro_bias_sigma);
   e.init_accel_bias_sigma = est.GetPositive("init_accel_bias_sigma", e.init_accel_bias_sigma);
+  e.init_max_tilt_error_rad =
+      est.GetNonNegative("init_max_tilt_error_rad", e.init_max_tilt_error_rad);
+  e.init_tilt_window_s = est.GetPositive("init_tilt_window_s", e.init_tilt_window_s);
   e.smoother_vision_floor_px =
       est.GetNonNegative("smoother_vision_floor_px", e.smoother_vision_floor_px);
   e.smoother_vision_correlation_time_s = est.GetNonNegative("smoother_vision_correlation_time_s",

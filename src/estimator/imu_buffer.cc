@@ -41,6 +41,17 @@ std::optional<Eigen::Vector3d> ImuBuffer::GyroAt(int64_t t_ns) const {
   return held.gyro;
 }
 
+std::optional<Eigen::Vector3d> ImuBuffer::MeanAccel(int64_t t0_ns, int64_t t1_ns,
+                                                    int min_samples) const {
+  auto it = std::lower_bound(samples_.begin(), samples_.end(), t0_ns,
+                             [](const ImuSample& s, int64_t t) { return s.t_ns < t; });
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (; it != samples_.end() && it->t_ns <= t1_ns; ++it, ++n) sum += it->accel;
+  if (n < std::max(1, min_samples)) return std::nullopt;
+  return sum / static_cast<double>(n);
+}
+
 std::optional<ImuPreintegration> ImuBuffer::Preintegrate(int64_t t0_ns, int64_t t1_ns,
                                                          const ImuBias& bias) const {
   if (samples_.empty() || t1_ns <= t0_ns) return std::nullopt;

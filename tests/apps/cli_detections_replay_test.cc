@@ -1,8 +1,14 @@
 // End-to-end: `simulate --detections-only` writes detections.csv instead of images, and `run` /
 // `smooth --detections` replay it through the estimator; `frontend`'s own detections.csv
 // replays too; a detections file that does not fit the calibration or the dock is one line,
-// exit 2, naming the file and line.
+// exit 2, naming the file and line; a `run` stopped by SIGINT or SIGTERM keeps, whole, every
+// row it wrote before the stop.
+#include <signal.h>
+
+#include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -10,7 +16,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "auvdock/io/decisions_csv.h"
 #include "auvdock/io/detections_csv.h"
+#include "auvdock/io/pose_covariance_csv.h"
 #include "auvdock/io/tum_io.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/temp_dir.h"
@@ -79,6 +87,47 @@ TEST_F(DetectionsReplayCli, ADatasetWithoutImagesPointsToTheDetections) {
   const auto r = test::RunAuvdock({"run", "--dataset", dataset_, "--out", *tmp_ / "no_images"});
   EXPECT_EQ(r.exit_status, 2);
   EXPECT_THAT(r.err, HasSubstr("--detections"));
+}
+
+int CountLines(const std::string& path) {
+  std::ifstream in(path);
+  int lines = 0;
+  for (std::string line; std::getline(in, line);) ++lines;
+  return lines;
+}
+
+TEST_F(DetectionsReplayCli, AnInterruptedRunKeepsEveryRowItWrote) {
+  for (const int signal : {SIGINT, SIGTERM}) {
+    const std::string out = *tmp_ / ("stopped_" + std::to_string(signal));
+    // Stop once 20 poses are out (the run writes 121 frames' worth, flushed per frame).
+    const auto r = test::RunAuvdockAndSignalWhen(
+        {"run", "--dataset", dataset_, "--detections", dataset_ + "/detections.csv", "--out", out,
+         "--quiet"},
+        [&] { return CountLines(out + "/trajectory.tum") >= 20; }, signal);
+    ASSERT_EQ(r.exit_status, 130) << "signal " << signal << ": " << r.err;
+    EXPECT_THAT(r.err, HasSubstr("interrupted"));
+    const Trajectory poses = ReadTumTrajectory(out + "/trajectory.tum");
+    EXPECT_GE(poses.size(), 20u);
+    EXPECT_LT(poses.size(), 115u) << "the run was not stopped early";
+    for (const StampedPose& pose : poses) {
+      EXPECT_TRUE(pose.T_D_B.p.allFinite() && pose.T_D_B.q.coeffs().allFinite()) << pose.t_ns;
+    }
+    // The other per-frame files parse to the last row and agree with the trajectory.
+    const std::vector<StampedPoseCovariance> covariances =
+        ReadPoseCovarianceCsv(out + "/covariance.csv");
+    const std::vector<StampedDecision> decisions = ReadDecisionsCsv(out + "/decisions.csv");
+    EXPECT_GE(covariances.size() + 2, poses.size());
+    EXPECT_LE(covariances.size(), poses.size());
+    std::set<int64_t> decided;
+    for (const StampedDecision& d : decisions) decided.insert(d.t_ns);
+    for (const StampedPose& pose : poses) {  // TUM times are seconds: within a microsecond
+      const auto next = decided.lower_bound(pose.t_ns - 1000);
+      EXPECT_TRUE(next != decided.end() && *next <= pose.t_ns + 1000) << pose.t_ns;
+    }
+    const nlohmann::json summary =
+        nlohmann::json::parse(test::ReadTextFile(out + "/summary.json"));
+    EXPECT_TRUE(summary.at("interrupted").get<bool>());
+  }
 }
 
 TEST_F(DetectionsReplayCli, DetectionsThatDoNotFitAreOneLineExitTwo) {

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "auvdock/geometry/pose3.h"
@@ -14,6 +15,8 @@
 
 namespace auvdock {
 namespace {
+
+using ::testing::HasSubstr;
 
 // The default docking run's first 14 s (stereo only, then both camera systems), without images.
 test::SyntheticRun MakeRun(uint64_t seed) {
@@ -86,6 +89,35 @@ int64_t DarkenFramesAfter(double dark_after_s, test::SyntheticRun* run) {
     frame.T_D_B_initial.reset();
   }
   return t_dark;
+}
+
+TEST(SlidingWindowEstimatorTest, AFirstPoseTurnedUpsideDownIsRefusedByTheAccelerometer) {
+  test::SyntheticRun run = MakeRun(4);
+  // No pose in frame 0 (the IMU starts with it); the next three per-frame poses turned by 180
+  // degrees about the body's x axis (what a wrongly identified frame can give), the rest as
+  // they are.
+  run.frames[0].T_D_B_initial.reset();
+  for (size_t k = 1; k < 4; ++k) {
+    Pose3& pose = *run.frames[k].T_D_B_initial;
+    pose.q = pose.q * Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
+  }
+  for (const bool check : {true, false}) {
+    EstimatorOptions options;
+    if (!check) options.init_max_tilt_error_rad = 0.0;
+    SlidingWindowEstimator estimator(run.calibration, run.dock, options);
+    size_t next_imu = 0;
+    for (size_t k = 0; k < 5; ++k) {
+      while (run.imu[next_imu].t_ns <= run.frames[k].t_ns) estimator.AddImu(run.imu[next_imu++]);
+      const auto out = estimator.AddVisionFrame(run.frames[k]);
+      EXPECT_EQ(out.has_value(), k == (check ? 4u : 1u) || (!check && k > 1))
+          << "check " << check << ", frame " << k;
+      if (check && k >= 1 && k < 4) {
+        EXPECT_THAT(estimator.init_refusal(), HasSubstr("tilt disagrees with the accelerometer"));
+      }
+    }
+    EXPECT_EQ(estimator.stats().init_refused, check ? 3 : 0);
+    EXPECT_TRUE(estimator.init_refusal().empty());
+  }
 }
 
 TEST(SlidingWindowEstimatorTest, RecoversTheTrajectoryFromPerturbedInitialPoses) {

@@ -16,7 +16,9 @@ namespace auvdock::test {
 
 namespace {
 
-CommandResult Run(const std::vector<std::string>& args, double delay_s, int signal) {
+// ready: polled until it holds (then `signal` is sent), the child ends, or timeout_s passes.
+CommandResult Run(const std::vector<std::string>& args, double delay_s, int signal,
+                  const std::function<bool()>& ready = {}, double timeout_s = 0.0) {
   TempDir capture;
   const std::string out_path = capture / "out.txt", err_path = capture / "err.txt";
   const pid_t pid = ::fork();
@@ -35,12 +37,26 @@ CommandResult Run(const std::vector<std::string>& args, double delay_s, int sign
     ::execv(program.c_str(), argv.data());
     std::_Exit(127);
   }
-  if (signal != 0) {
+  int status = 0;
+  bool reaped = false;
+  if (signal != 0 && ready) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (std::chrono::steady_clock::now() < deadline) {
+      if (::waitpid(pid, &status, WNOHANG) == pid) {
+        reaped = true;
+        break;
+      }
+      if (ready()) {
+        ::kill(pid, signal);
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  } else if (signal != 0) {
     std::this_thread::sleep_for(std::chrono::duration<double>(delay_s));
     ::kill(pid, signal);
   }
-  int status = 0;
-  ::waitpid(pid, &status, 0);
+  if (!reaped) ::waitpid(pid, &status, 0);
   CommandResult result;
   result.exit_status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   result.out = ReadTextFile(out_path);
@@ -55,6 +71,12 @@ CommandResult RunAuvdock(const std::vector<std::string>& args) { return Run(args
 CommandResult RunAuvdockAndSignal(const std::vector<std::string>& args, double delay_s,
                                   int signal) {
   return Run(args, delay_s, signal);
+}
+
+CommandResult RunAuvdockAndSignalWhen(const std::vector<std::string>& args,
+                                      const std::function<bool()>& ready, int signal,
+                                      double timeout_s) {
+  return Run(args, 0.0, signal, ready, timeout_s);
 }
 
 }  // namespace auvdock::test

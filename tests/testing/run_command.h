@@ -1,6 +1,7 @@
 // Runs the auvdock CLI as a child process and captures its exit status, stdout and stderr.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -17,5 +18,11 @@ CommandResult RunAuvdock(const std::vector<std::string>& args);
 
 // Starts build/bin/auvdock, sends `signal` after `delay_s`, waits; returns the exit status.
 CommandResult RunAuvdockAndSignal(const std::vector<std::string>& args, double delay_s, int signal);
+
+// Starts build/bin/auvdock and sends `signal` as soon as ready() holds (polled every 2 ms; not
+// sent if the command ends first or timeout_s passes), waits; returns the exit status.
+CommandResult RunAuvdockAndSignalWhen(const std::vector<std::string>& args,
+                                      const std::function<bool()>& ready, int signal,
+                                      double timeout_s = 60.0);
 
 }  // namespace auvdock::test

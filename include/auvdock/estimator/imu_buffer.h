@@ -39,6 +39,9 @@ class ImuBuffer {
   // within max_gap_s before t_ns.
   std::optional<Eigen::Vector3d> GyroAt(int64_t t_ns) const;
 
+  // The mean accelerometer sample (specific force, m/s^2, in B, bias not removed) over the
+  // samples with t0_ns <= t <= t1_ns; nothing when fewer than min_samples lie there.
+  std::optional<Eigen::Vector3d> MeanAccel(int64_t t0_ns, int64_t t1_ns, int min_samples) const;
   // Forgets samples no longer needed for intervals starting at or after t_ns.
   void DropBefore(int64_t t_ns);
 

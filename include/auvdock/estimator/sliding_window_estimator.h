@@ -25,8 +25,9 @@
 // (estimator/sensor_factors.h).
 //
 // Initialisation: at the first frame with a per-frame pose (VisionFrame::T_D_B_initial): that
-// pose, zero velocity and zero biases, each with a prior (EstimatorOptions). The attitude then
-// refines against gravity through the IMU factors (gravity_D is the dock's, not a constant).
+// pose, zero velocity and zero biases, each with a prior (EstimatorOptions), unless the pose's
+// tilt disagrees with the accelerometer (init_max_tilt_error_rad). The attitude then refines
+// against gravity through the IMU factors (gravity_D is the dock's, not a constant).
 // Reset: an IMU gap longer than max_imu_gap_s, or a failed solve, drops the window and waits
 // for the next per-frame pose; every reset is counted and logged.
 //
@@ -90,6 +91,15 @@ struct EstimatorOptions {
   double init_velocity_sigma_mps = 0.5;
   double init_gyro_bias_sigma = 0.01;   // rad/s
   double init_accel_bias_sigma = 0.1;   // m/s^2
+  // A first pose whose tilt disagrees with the accelerometer is refused: the mean specific
+  // force f_B over the last init_tilt_window_s before the frame must lie within
+  // init_max_tilt_error_rad of the direction the pose predicts for a vehicle that does not
+  // accelerate, -R_DB^T g_D (a docking vehicle's accelerations, well under 1 m/s^2, and the
+  // accelerometer's bias tilt it by a few degrees at most). A wrongly identified frame can give a
+  // pose turned upside down about the docking axis; started from it, the window took seconds to
+  // recover (Monte-Carlo audit, README). 0: no check.
+  double init_max_tilt_error_rad = 0.26;  // 15 degrees
+  double init_tilt_window_s = 0.5;
   bool compute_covariance = true;       // marginal covariance of the newest pose every frame
   // Online variance factors of each light's mono pixels and stereo points, from each frame's
   // residuals after the solve and their leverage on the newest pose (adaptive_noise_scale.h;
@@ -189,6 +199,7 @@ struct EstimatorStats {
   int gated_observations = 0;
   int used_observations = 0;
   int resets = 0;
+  int init_refused = 0;  // per-frame poses refused as the first state (tilt against the IMU)
   int solver_failures = 0;
   int covariance_failures = 0;
   int depth_used = 0;     // depth samples in the cost (after gating)
@@ -258,6 +269,8 @@ class SlidingWindowEstimator {
 
   const EstimatorStats& stats() const { return stats_; }
   bool initialized() const { return !window_.empty(); }
+  // Why the last frame with a per-frame pose did not start the window (empty if none did not).
+  const std::string& init_refusal() const { return init_refusal_; }
 
  private:
   struct State;
@@ -317,6 +330,7 @@ class SlidingWindowEstimator {
   int64_t last_vision_t_ns_ = INT64_MIN;
   bool symmetry_unresolved_ = false;  // of the window's first pose (EstimatorOutput)
   int64_t last_dvl_t_ns_ = INT64_MIN;
+  std::string init_refusal_;
   EstimatorStats stats_;
   // Per light id: the adaptive variance factors of its mono pixels and its stereo points.
   std::map<int, AdaptiveNoiseScale> mono_noise_;
