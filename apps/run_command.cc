@@ -76,11 +76,13 @@ void Run(const RunOptions& options) {
         counters.symmetry_unresolved += out->symmetry_unresolved;
         writer.Write(*out, decision);
       } else {
-        writer.WriteNoEstimate(frame->t_ns, go_no_go.NoEstimate(
-                                                estimator.initialized() ? "estimator reset"
-                                                : !estimator.init_refusal().empty()
-                                                    ? "not initialised (" + estimator.init_refusal() + ")"
-                                                    : "not initialised (waiting for a per-frame pose)"));
+        const std::string why = estimator.initialized() ? "estimator reset"
+                                : estimator.init_refusal().empty()
+                                    ? "waiting for a per-frame pose"
+                                    : estimator.init_refusal();
+        writer.WriteNoEstimate(
+            frame->t_ns,
+            go_no_go.NoEstimate(estimator.initialized() ? why : "not initialised (" + why + ")"));
       }
       const std::vector<std::string>& log = estimator.stats().log;
       for (; log_printed < log.size(); ++log_printed) {

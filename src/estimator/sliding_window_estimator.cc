@@ -120,31 +120,33 @@ void SlidingWindowEstimator::AddImu(const ImuSample& sample) {
                                   : std::min({window_.front()->t_ns, rate_test_ns, late_fix_ns}));
 }
 
+std::string SlidingWindowEstimator::TiltRefusal(const VisionFrame& frame) const {
+  if (!(options_.init_max_tilt_error_rad > 0.0)) return {};
+  const int64_t window_ns = static_cast<int64_t>(options_.init_tilt_window_s * 1e9);
+  const std::optional<Eigen::Vector3d> f_B =
+      imu_.MeanAccel(frame.t_ns - window_ns, frame.t_ns, /*min_samples=*/3);
+  const Eigen::Vector3d expected_B = -(frame.T_D_B_initial->q.conjugate() * dock_.gravity_D);
+  if (!f_B || !(f_B->norm() > 0.0) || !(expected_B.norm() > 0.0)) return {};
+  const double angle = std::atan2(f_B->cross(expected_B).norm(), f_B->dot(expected_B));
+  if (angle <= options_.init_max_tilt_error_rad) return {};
+  char text[160];
+  std::snprintf(text, sizeof(text),
+                "first pose refused: its tilt disagrees with the accelerometer by %.1f deg "
+                "(at most %.1f)",
+                angle * 180.0 / M_PI, options_.init_max_tilt_error_rad * 180.0 / M_PI);
+  return text;
+}
+
 bool SlidingWindowEstimator::Initialize(const VisionFrame& frame) {
   if (!frame.T_D_B_initial) return false;
-  if (options_.init_max_tilt_error_rad > 0.0) {
-    const int64_t window_ns = static_cast<int64_t>(options_.init_tilt_window_s * 1e9);
-    const std::optional<Eigen::Vector3d> f_B =
-        imu_.MeanAccel(frame.t_ns - window_ns, frame.t_ns, /*min_samples=*/3);
-    const Eigen::Vector3d expected_B = -(frame.T_D_B_initial->q.conjugate() * dock_.gravity_D);
-    if (f_B && f_B->norm() > 0.0 && expected_B.norm() > 0.0) {
-      const double angle =
-          std::atan2(f_B->cross(expected_B).norm(), f_B->dot(expected_B));
-      if (angle > options_.init_max_tilt_error_rad) {
-        ++stats_.init_refused;
-        char text[160];
-        std::snprintf(text, sizeof(text),
-                      "first pose refused: its tilt disagrees with the accelerometer by %.1f deg "
-                      "(at most %.1f)",
-                      angle * 180.0 / M_PI, options_.init_max_tilt_error_rad * 180.0 / M_PI);
-        init_refusal_ = text;
-        if (stats_.init_refused == 1) {
-          stats_.log.push_back(init_refusal_ + " at " + std::to_string(frame.t_ns) +
-                               " ns (further refusals are counted in init_refused)");
-        }
-        return false;
-      }
+  if (const std::string refusal = TiltRefusal(frame); !refusal.empty()) {
+    ++stats_.init_refused;
+    init_refusal_ = refusal;
+    if (stats_.init_refused == 1) {
+      stats_.log.push_back(refusal + " at " + std::to_string(frame.t_ns) +
+                           " ns (further refusals are counted in init_refused)");
     }
+    return false;
   }
   init_refusal_.clear();
   symmetry_unresolved_ = frame.symmetry_unresolved;

@@ -294,6 +294,9 @@ class SlidingWindowEstimator {
                                             const AddFactor& add, double max_before_s = 0.0);
   // The state's blocks for the measurement factors (estimator/state_blocks.h).
   StateBlocks BlocksOf(State& state) const;
+  // Why the frame's per-frame pose may not start the window (init_max_tilt_error_rad), or empty;
+  // empty too when fewer than 3 accelerometer samples lie in init_tilt_window_s before it.
+  std::string TiltRefusal(const VisionFrame& frame) const;
   // The state a measurement at t_ns attaches to: the newest at or before it, else the oldest
   // when t_ns is at most max_before_s before it (a late measurement) and not before the first
   // state since the last initialisation, else none.
