@@ -23,6 +23,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "apps/commands.h"
+#include "apps/reason_class.h"
 #include "apps/signal_flag.h"
 #include "auvdock/io/csv.h"
 #include "auvdock/io/dataset.h"
@@ -157,7 +158,7 @@ void RunFrontend(const FrontendOptions& options) {
       if (cameras[c] && !obs.reason.empty()) reason += "; " + cameras[c]->name + ": " + obs.reason;
     }
     std::replace(reason.begin(), reason.end(), ',', ';');
-    if (!frame.T_D_B) ++no_pose_reasons[frame.reason];
+    if (!frame.T_D_B) ++no_pose_reasons[ReasonClass(frame.reason)];
     stages.Line(stage_row + "," + reason);
     if (frame.T_D_B) fused.Append({t, *frame.T_D_B});
     if (frame.T_D_B_stereo) stereo.Append({t, *frame.T_D_B_stereo});
