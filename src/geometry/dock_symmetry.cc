@@ -94,6 +94,29 @@ std::vector<DockSymmetry> FindDockSymmetries(const DockModel& dock, double toler
   return out;
 }
 
+std::vector<int> PermuteLabelling(const std::vector<int>& detection_of_light,
+                                  const DockSymmetry& s) {
+  std::vector<int> out(detection_of_light.size(), -1);
+  for (size_t i = 0; i < detection_of_light.size(); ++i) {
+    out[s.permutation[i]] = detection_of_light[i];
+  }
+  return out;
+}
+
+size_t CanonicalSymmetry(const std::vector<DockSymmetry>& symmetries,
+                         const std::vector<int>& detection_of_light) {
+  size_t best = 0;
+  std::vector<int> smallest = detection_of_light;
+  for (size_t k = 1; k < symmetries.size(); ++k) {
+    std::vector<int> copy = PermuteLabelling(detection_of_light, symmetries[k]);
+    if (copy < smallest) {
+      smallest = std::move(copy);
+      best = k;
+    }
+  }
+  return best;
+}
+
 std::string DescribeDockSymmetries(const std::vector<DockSymmetry>& symmetries) {
   if (symmetries.size() <= 1) return "none";
   std::ostringstream s;

@@ -39,17 +39,18 @@ MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detectio
   MonoPoseResult result;
   result.light_ids.assign(detections.size(), -1);
 
-  // The noise the detections claim (their own covariances), never below the camera's.
-  double trace_sum = 0.0;
-  int measured = 0;
+  // The noise the detections claim (their own covariances), never below the camera's: the
+  // median detection's, so that one detection with a wide covariance (a light cut by the border,
+  // a blob in a glow) does not widen every gate of the frame.
+  std::vector<double> claimed;
   for (const LightDetection& d : detections) {
-    if (d.covariance.trace() > 0.0) {
-      trace_sum += d.covariance.trace();
-      ++measured;
-    }
+    if (d.covariance.trace() > 0.0) claimed.push_back(std::sqrt(d.covariance.trace() / 2.0));
   }
   double sigma = camera_.pixel_noise_px;
-  if (measured > 0) sigma = std::max(sigma, std::sqrt(trace_sum / measured / 2.0));
+  if (!claimed.empty()) {
+    std::nth_element(claimed.begin(), claimed.begin() + claimed.size() / 2, claimed.end());
+    sigma = std::max(sigma, claimed[claimed.size() / 2]);
+  }
   result.pixel_sigma_px = sigma;
 
   const bool can_track =

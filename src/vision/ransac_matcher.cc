@@ -530,26 +530,23 @@ std::string Labels(const Scene& scene, const Hypothesis& h) {
   return out.str();
 }
 
-// The labelling of h with a dock symmetry applied: light permutation[i] takes light i's
-// detection, and the pose becomes T S^-1 (the same pixels: T S^-1 p_perm(i) = T p_i).
+// The hypothesis h with a dock symmetry applied: its labelling permuted (PermuteLabelling), the
+// pose T S^-1 (the same pixels: T S^-1 p_perm(i) = T p_i).
 Hypothesis ApplySymmetry(const Hypothesis& h, const DockSymmetry& s) {
   Hypothesis out = h;
-  for (size_t i = 0; i < h.detection_of_light.size(); ++i) {
-    out.detection_of_light[s.permutation[i]] = h.detection_of_light[i];
-  }
+  out.detection_of_light = PermuteLabelling(h.detection_of_light, s);
   out.pose.R = h.pose.R * s.R.transpose();
   out.pose.t = h.pose.t - out.pose.R * s.t;
   return out;
 }
 
-// Replaces *h by one representative of its symmetric copies (the lexicographically smallest
-// labelling), so that copies are the same hypothesis, not rivals. Nothing to do (and no copy
-// made) for a dock without symmetry: this runs for every scored pose.
+// Replaces *h by one representative of its symmetric copies (CanonicalSymmetry), so that copies
+// are the same hypothesis, not rivals. Nothing to do for a dock without symmetry: this runs for
+// every scored pose.
 void Canonicalize(const std::vector<DockSymmetry>& symmetries, Hypothesis* h) {
-  for (size_t k = 1; k < symmetries.size(); ++k) {
-    Hypothesis copy = ApplySymmetry(*h, symmetries[k]);
-    if (copy.detection_of_light < h->detection_of_light) *h = std::move(copy);
-  }
+  if (symmetries.size() < 2) return;
+  const size_t k = CanonicalSymmetry(symmetries, h->detection_of_light);
+  if (k != 0) *h = ApplySymmetry(*h, symmetries[k]);
 }
 
 // Spread off the best line below this fraction of the spread along it: collinear.

@@ -1,7 +1,10 @@
 // FindDockSymmetries on the shipped layouts and on hand-made ones with known symmetry groups.
 #include "auvdock/geometry/dock_symmetry.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <random>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -94,6 +97,39 @@ TEST(DockSymmetry, ToleranceDecides) {
 TEST(DockSymmetry, CollinearLayoutGivesTheIdentity) {
   const DockModel dock = test::LoadDock("centerline_8.yaml");
   EXPECT_EQ(FindDockSymmetries(dock).size(), 1u);
+}
+
+}  // namespace
+}  // namespace auvdock
+
+namespace auvdock {
+namespace {
+
+// A labelling and each of its symmetric copies have one representative: the copies of a
+// partly seen ring are one hypothesis for the matcher, never rivals.
+TEST(DockSymmetry, AllCopiesOfALabellingShareOneRepresentative) {
+  const DockModel dock = test::LoadDock("ring_8.yaml");
+  const auto s = FindDockSymmetries(dock);
+  ASSERT_EQ(s.size(), 4u);
+  std::mt19937_64 rng(3);
+  for (int trial = 0; trial < 200; ++trial) {
+    // 4-6 consecutive lights labelled with distinct detection indices, the rest unseen.
+    const int n = static_cast<int>(dock.lights.size());
+    const int seen = 4 + trial % 3;
+    std::vector<int> detections(n);
+    std::iota(detections.begin(), detections.end(), 0);
+    std::shuffle(detections.begin(), detections.end(), rng);
+    std::vector<int> labelling(n, -1);
+    const int first = static_cast<int>(rng() % n);
+    for (int k = 0; k < seen; ++k) labelling[(first + k) % n] = detections[k];
+    const std::vector<int> representative =
+        PermuteLabelling(labelling, s[CanonicalSymmetry(s, labelling)]);
+    for (const DockSymmetry& sym : s) {
+      const std::vector<int> copy = PermuteLabelling(labelling, sym);
+      EXPECT_EQ(PermuteLabelling(copy, s[CanonicalSymmetry(s, copy)]), representative);
+      EXPECT_LE(representative, copy);  // the smallest of all copies
+    }
+  }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // MatchRansac on symmetric docks (ring of 8: 4-fold; corners + raised centre: 2-fold): a pose is
 // given in every view (not "ambiguous"), the labels are right up to the symmetry, every rival
 // pose is listed, and a hint (prediction, gravity, approach side) picks the true copy.
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -41,8 +42,10 @@ struct Counts {
   int views = 0, ok = 0, right_up_to_symmetry = 0, right_copy = 0;
 };
 
+// num_visible > 0: only that many consecutive lights (by id order) are in the image, as when a
+// ring leaves the image's side.
 Counts RunViews(const std::string& dock_file, int num_views, int num_spurious, bool give_prediction,
-           bool give_gravity) {
+           bool give_gravity, int num_visible = 0) {
   const DockModel dock = test::LoadDock(dock_file);
   const auto symmetries = FindDockSymmetries(dock);
   const PinholeRadtanCamera camera = test::DefaultMonoCamera();
@@ -51,8 +54,12 @@ Counts RunViews(const std::string& dock_file, int num_views, int num_spurious, b
   Counts c;
   for (int v = 0; v < num_views; ++v) {
     const Pose3 T_C_D = test::RandomView(dock, camera, 25 * kDeg, rng);
-    const test::View view =
-        test::MakeView(dock, camera, T_C_D, test::AllLightIds(dock), num_spurious, 0.3, rng);
+    std::vector<int> visible = test::AllLightIds(dock);
+    if (num_visible > 0) {
+      std::rotate(visible.begin(), visible.begin() + v % visible.size(), visible.end());
+      visible.resize(num_visible);
+    }
+    const test::View view = test::MakeView(dock, camera, T_C_D, visible, num_spurious, 0.3, rng);
     SymmetryHint hint;
     if (give_prediction) {
       // A prediction a couple of degrees and centimetres off, as tracking gives.
@@ -78,6 +85,16 @@ TEST(RansacSymmetricDock, RingGivesAPoseUpToItsSymmetry) {
   const Counts c = RunViews("ring_8.yaml", 60, 0, false, false);
   EXPECT_GE(c.ok, 57);  // >= 95 %: a symmetric dock is no reason to refuse
   EXPECT_EQ(c.right_up_to_symmetry, c.ok);
+}
+
+// Part of the ring in view: the labellings of a hypothesis's symmetric copies are one
+// hypothesis, never rivals ("two labellings explain ..." with labels a quarter turn apart).
+TEST(RansacSymmetricDock, PartOfTheRingGivesAPoseNotRivalCopies) {
+  for (const int visible : {5, 6}) {
+    const Counts c = RunViews("ring_8.yaml", 40, 3, false, false, visible);
+    EXPECT_GE(c.ok, 36) << visible << " lights in view";
+    EXPECT_EQ(c.right_up_to_symmetry, c.ok);
+  }
 }
 
 TEST(RansacSymmetricDock, RingWithSpuriousDetections) {

@@ -41,6 +41,20 @@ struct DockSymmetry {
 
 std::vector<DockSymmetry> FindDockSymmetries(const DockModel& dock, double tolerance_m = 0.01);
 
+// A labelling (per light, in DockModel::lights order: the index of its detection, or -1) seen
+// through symmetry s: light i's detection becomes light permutation[i]'s. The labelling and its
+// copies explain the same pixels with poses T and T S^-1.
+std::vector<int> PermuteLabelling(const std::vector<int>& detection_of_light,
+                                  const DockSymmetry& s);
+
+// The index k of the symmetry whose copy of the labelling is the lexicographically smallest:
+// one representative for all copies, so that copies count as one labelling, not as rivals.
+// Every copy is made from the labelling itself: applying the symmetries one after another to the
+// smallest so far visits products of them and can miss a copy (a 4-fold ring's copies a
+// half-turn apart then had different representatives).
+size_t CanonicalSymmetry(const std::vector<DockSymmetry>& symmetries,
+                         const std::vector<int>& detection_of_light);
+
 // "4-fold about (0, 0, 1)" style summary of the non-identity symmetries; "none" without any.
 std::string DescribeDockSymmetries(const std::vector<DockSymmetry>& symmetries);
 
