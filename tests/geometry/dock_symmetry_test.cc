@@ -99,12 +99,6 @@ TEST(DockSymmetry, CollinearLayoutGivesTheIdentity) {
   EXPECT_EQ(FindDockSymmetries(dock).size(), 1u);
 }
 
-}  // namespace
-}  // namespace auvdock
-
-namespace auvdock {
-namespace {
-
 // A labelling and each of its symmetric copies have one representative: the copies of a
 // partly seen ring are one hypothesis for the matcher, never rivals.
 TEST(DockSymmetry, AllCopiesOfALabellingShareOneRepresentative) {
