@@ -34,7 +34,9 @@ BlobLightDetector::BlobLightDetector(const BlobLightDetectorOptions& options) : 
       !(c.floor_px >= 0.0) || !(options.min_separation_px >= 0.0) ||
       !(options.border_sigma_fraction >= 0.0) || options.max_detections < 1 ||
       !(options.halo_extent_sigmas >= 0.0) || !(options.max_response_in_halo >= 0.0) ||
-      !(options.checks.halo_radius_sigmas > 0.0)) {
+      !(options.checks.halo_radius_sigmas > 0.0) ||
+      !(options.checks.max_core_elongation >= 1.0) ||
+      !(options.checks.max_core_stretch_px >= 0.0) || !(options.close_light_min_sigma_px > 0.0)) {
     throw std::invalid_argument("BlobLightDetectorOptions out of range");
   }
   FindBlobCandidates(cv::Mat::zeros(16, 16, CV_32F), options.candidates);  // checks its options
@@ -66,7 +68,11 @@ std::vector<LightDetection> BlobLightDetector::Detect(
   std::vector<Kept> kept;
   LightCandidateCheckOptions checks = options_.checks;
   if (min_halo_excess) checks.min_halo_excess = *min_halo_excess;
-  for (const BlobCandidate& candidate : FindBlobCandidates(luma, options_.candidates)) {
+  std::vector<BlobCandidate> candidates = FindBlobCandidates(luma, options_.candidates);
+  std::stable_partition(candidates.begin(), candidates.end(), [&](const BlobCandidate& c) {
+    return c.sigma_px <= options_.close_light_min_sigma_px;
+  });
+  for (const BlobCandidate& candidate : candidates) {
     auto reject = [&](const Eigen::Vector2d& uv, const std::string& reason) {
       if (rejected) rejected->push_back({uv, candidate.sigma_px, reason});
     };
@@ -87,7 +93,13 @@ std::vector<LightDetection> BlobLightDetector::Detect(
       continue;
     }
     std::string overlap;
+    const bool close_light = candidate.sigma_px > options_.close_light_min_sigma_px;
     for (const Kept& k : kept) {
+      if (close_light && (k.detection.uv - core->uv).norm() <
+                             options_.halo_extent_sigmas * candidate.sigma_px) {
+        overlap = "larger than a light among lights";
+        break;
+      }
       const double distance = (k.detection.uv - core->uv).norm();
       const double separation =
           std::max({options_.min_separation_px, k.detection.radius_px, core->radius_px});

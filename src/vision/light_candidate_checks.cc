@@ -132,7 +132,10 @@ std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore&
     return "extended";
   }
   if (core.touches_border) return "cut by the border";
-  if (core.elongation > options.max_core_elongation && core.area_px >= 12) return "elongated";
+  const double stretch = options.max_core_stretch_px / std::max(core.radius_px, 1e-3);
+  const double max_elongation =
+      std::min(options.max_core_elongation, std::sqrt(1.0 + stretch * stretch / 3.0));
+  if (core.elongation > max_elongation && core.area_px >= 12) return "elongated";
   if (evidence.peak_drop < options.min_peak_drop ||
       (!evidence.saturated &&
        evidence.peak_drop < options.min_peak_drop_fraction * (core.peak - core.floor))) {

@@ -357,6 +357,9 @@ TEST(BlobLightDetector, SmallBlobsOnTheEdgeOfASaturatedSurfaceAreNotLights) {
   EXPECT_TRUE(has_led(with_test));
   EXPECT_EQ(small_on_the_edge(with_test), 0);
   options.checks.min_open_drop_fraction = 0.0;
+  // Without it the whole funnel (round, r ~77 px) passes the checks as a light; its glow would
+  // hide the blobs on its edge: keep them visible.
+  options.max_response_in_halo = 0.0;
   const auto without_test = BlobLightDetector(options).Detect(bgr);
   EXPECT_TRUE(has_led(without_test));
   EXPECT_GT(small_on_the_edge(without_test), 0);
@@ -387,6 +390,70 @@ TEST(BlobCandidates, ALargeStructureDoesNotHideASmallLightBesideIt) {
   bool at_largest = false;
   for (const BlobCandidate& c : FindBlobCandidates(image, o)) at_largest |= c.sigma_px > 19.9;
   EXPECT_TRUE(at_largest);
+}
+
+// A light a few decimetres from the lens: a saturated disc of 50 px radius in a blue glow of
+// 50 px sigma (a blob scale of ~45 px, beyond the 28 px that the scales reached before). Beside
+// it a lit patch about as large and as bright, in the same glow, but twice as long as it is wide
+// (a white funnel's interior between its vanes): the light is found, the patch is not, and says
+// why. (Either half fails with the old scales or without the roundness limit of large cores.)
+TEST(BlobLightDetector, AVeryCloseLightIsFoundAndALargeLitPatchIsNot) {
+  cv::Mat image(512, 640, CV_32FC3, cv::Scalar(60, 70, 30));
+  const Led close_light{Eigen::Vector2d(190.3, 255.6), 50.0, 50.0};
+  AddLed(close_light, &image);
+  cv::Mat patch(image.size(), CV_32FC3, cv::Scalar(0, 0, 0));
+  cv::ellipse(patch, cv::Point(480, 256), cv::Size(70, 32), 0, 0, 360,
+              cv::Scalar(400, 400, 400), cv::FILLED);
+  cv::Mat glow;
+  cv::GaussianBlur(patch, glow, cv::Size(0, 0), 20.0);
+  image += patch + glow.mul(cv::Scalar(0.8, 0.45, 0.1));
+  cv::Mat bgr;
+  image.convertTo(bgr, CV_8UC3);
+  BlobLightDetectorOptions options;
+  options.checks.colour = LightColour::kBlue;
+  std::vector<RejectedLightCandidate> rejected;
+  const auto found = BlobLightDetector(options).Detect(bgr, &rejected);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_LT((found[0].uv - close_light.uv).norm(), 1.0);
+  bool patch_said_why = false;
+  for (const auto& r : rejected) {
+    patch_said_why |= (r.uv - Eigen::Vector2d(480, 256)).norm() < 20.0 && r.reason == "elongated";
+  }
+  EXPECT_TRUE(patch_said_why);
+}
+
+// A large round bright plateau among small lights (a white funnel's interior ringed by LEDs 1.5
+// plateau radii from its centre, in a grey image where no colour tells them apart) is not a light
+// a few decimetres away: that would outshine the others and lie far from them in the image. It
+// is judged after them, and hides none.
+TEST(BlobLightDetector, ALargePlateauAmongLightsIsNotACloseLight) {
+  cv::Mat image(480, 640, CV_32FC3, cv::Scalar(60, 70, 30));
+  cv::circle(image, cv::Point(320, 240), 60, cv::Scalar(400, 400, 400), cv::FILLED);
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 1.5);
+  std::vector<Led> leds;
+  for (int k = 0; k < 6; ++k) {
+    const double a = 2.0 * 3.14159265358979 * k / 6.0;
+    leds.push_back({Eigen::Vector2d(320.3 + 90.0 * std::cos(a), 240.6 + 90.0 * std::sin(a)), 3.0,
+                    6.0});
+    AddLed(leds.back(), &image);
+  }
+  cv::Mat bgr, grey;
+  image.convertTo(bgr, CV_8UC3);
+  cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+  std::vector<RejectedLightCandidate> rejected;
+  const auto found = BlobLightDetector(BlueOptions()).Detect(grey, &rejected);
+  EXPECT_EQ(found.size(), leds.size());
+  for (const Led& led : leds) {
+    EXPECT_TRUE(std::any_of(found.begin(), found.end(), [&](const LightDetection& d) {
+      return (d.uv - led.uv).norm() < 1.0;
+    })) << "LED at " << led.uv.transpose();
+  }
+  bool said_why = false;
+  for (const auto& r : rejected) {
+    said_why |= (r.uv - Eigen::Vector2d(320, 240)).norm() < 5.0 &&
+                r.reason == "larger than a light among lights";
+  }
+  EXPECT_TRUE(said_why);
 }
 
 TEST(BlobLightDetector, BadInputThrows) {

@@ -14,7 +14,11 @@
 // candidates -> per candidate: core, evidence, checks -> detections closer than the larger
 // core radius (at least min_separation_px) to a stronger one are the same light, and much weaker
 // ones in a stronger light's halo are its glow (halo_extent_sigmas, max_response_in_halo) -> at most
-// max_detections by score. A detection whose halo ring leaves the image is flagged at_border
+// max_detections by score. Candidates at scales above close_light_min_sigma_px (a light within
+// decimetres of the lens, or a large bright structure) are judged after all others and suppress
+// none of them: one is kept only if no kept light lies within halo_extent_sigmas of its sigma (a
+// light that close outshines the others and is far from them in the image; a white funnel's
+// plateau has the dock's lights round it). A detection whose halo ring leaves the image is flagged at_border
 // and its covariance widened by (border_sigma_fraction sigma)^2 per axis: the cut biases the
 // centroid by a fraction of the light's size.
 //
@@ -42,10 +46,12 @@ struct BlobLightDetectorOptions {
   bool deinterlace = false;  // keep the even field, rebuild odd rows (combing)
   // Scale-normalised LoG response of at least 30 gray levels: a light of ~60 levels of contrast
   // at its own scale (lower thresholds let the pool footage's clutter through: at 10, precision
-  // 0.12 on the pool clip). Scales 1.44 apart from 1.5 px (the optics' blur) to 40 px; maxima at
-  // the largest are dropped (blob_candidates.h), so lights up to sigma ~28 px (a saturated
-  // plateau of ~40 px radius) are found.
-  BlobCandidateOptions candidates{/*min_sigma_px=*/1.5, /*max_sigma_px=*/40.0, /*num_scales=*/10,
+  // 0.12 on the pool clip). Scales 1.44 apart from 1.5 px (the optics' blur) to 120 px; maxima
+  // at the largest are dropped (blob_candidates.h), so lights up to sigma ~80 px (a saturated
+  // plateau of ~110 px radius: a light a few decimetres from the lens) are found. Large bright
+  // structures at those scales are told from lights by their shape (light_candidate_checks.h:
+  // a large core must be round).
+  BlobCandidateOptions candidates{/*min_sigma_px=*/1.5, /*max_sigma_px=*/119.5, /*num_scales=*/13,
                                   /*min_response=*/30.0};
   double score_response = 60.0;  // a response that scores full strength
   LightCoreOptions core;
@@ -56,6 +62,7 @@ struct BlobLightDetectorOptions {
   // illuminates, a reflection. Two real lights that close in the image are about equally bright.
   double halo_extent_sigmas = 3.5;
   double max_response_in_halo = 0.5;
+  double close_light_min_sigma_px = 30.0;
   double border_sigma_fraction = 0.5;
   int max_detections = 64;
 };

@@ -60,9 +60,18 @@ struct LightCandidateCheckOptions {
   double min_open_drop_fraction = 0.4;
   double max_core_radius_sigmas = 2.0;  // a core wider than this is a bright surface
   double max_flatness = 0.85;
-  // A light's core is round: an emitting disc seen through round optics (motion blur of a few
-  // pixels, combing or a lobe stretch it a little); a lit patch of a structure need not be.
+  // A light's core is round: an emitting disc seen through round optics (motion blur, the two
+  // fields of interlaced video, an asymmetric lobe or sensor bloom stretch it); a lit patch of a
+  // structure need not be. A disc of radius r stretched along a line by s pixels has an
+  // elongation of sqrt(1 + s^2 / (3 r^2)) (second moments r^2/4 + s^2/12 and r^2/4): the limit is
+  // the smaller of max_core_elongation and that for s = max_core_stretch_px (r being the
+  // stretched core's own equivalent radius, the pool clip's smeared LEDs need s ~ 35). So a large
+  // core must be nearly round (1.10 at a radius of 50 px), and a large patch of a white funnel or
+  // a deck is not a light (1.7-2.6 on the pool clip at radii of 40-60 px). This costs the close
+  // lights of the randomised renders that bloom and lobes stretch to 1.1-1.3 (a floor of 1.5 on
+  // the limit recovered 0.2 % of their lights, at a thin margin from the pool's funnel patches).
   double max_core_elongation = 3.5;
+  double max_core_stretch_px = 45.0;
   double min_flat_sigma_px = 3.0;
   double saturation_level = 250.0;  // gray levels, any channel
 };
