@@ -3,6 +3,7 @@
 // --covariance the consistency of the reported covariances (NEES).
 // The metrics are defined in include/auvdock/eval/trajectory_evaluation.h.
 #include <cmath>
+#include <filesystem>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -14,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/commands.h"
+#include "apps/plot_script.h"
 #include "auvdock/estimator/go_no_go.h"
 #include "auvdock/eval/trajectory_evaluation.h"
 #include "auvdock/geometry/so3.h"
@@ -38,6 +40,7 @@ struct EvaluateOptions {
   std::string align = "none";
   double rpe_delta_s = 1.0;
   double max_truth_gap_s = 0.1;
+  std::string plots_dir;  // optional: PNG plots (plot_script.h)
 };
 
 // CLI11's PositiveNumber prints its range up to DBL_MAX in full; this says what is meant.
@@ -199,6 +202,7 @@ void RunEvaluate(const EvaluateOptions& options) {
   evaluation.rpe_delta_s = options.rpe_delta_s;
   evaluation.max_truth_gap_s = options.max_truth_gap_s;
 
+  const std::string plot_script = options.plots_dir.empty() ? "" : FindPlotScript();
   const Dataset dataset = LoadDataset(options.dataset_dir);
   if (dataset.groundtruth.empty()) {
     throw InputError(options.dataset_dir + ": dataset has no ground truth");
@@ -225,6 +229,21 @@ void RunEvaluate(const EvaluateOptions& options) {
   } else {
     PrintTable(options, report);
     std::fflush(stdout);
+  }
+  if (!plot_script.empty()) {
+    std::vector<std::string> args = {"--dataset", options.dataset_dir, "--estimate",
+                                     options.estimate_path, "--out", options.plots_dir};
+    const std::string label =
+        std::filesystem::absolute(options.estimate_path).parent_path().filename().string();
+    if (!label.empty()) args.insert(args.end(), {"--label", label});
+    if (!options.covariance_path.empty()) {
+      args.insert(args.end(), {"--covariance", options.covariance_path});
+    }
+    if (!options.decisions_path.empty()) {
+      args.insert(args.end(), {"--decisions", options.decisions_path});
+    }
+    std::fflush(stdout);
+    RunPlotScript(plot_script, args);
   }
 }
 
@@ -267,6 +286,11 @@ void AddEvaluateCommand(CLI::App& root) {
                   "seconds (default 0.1)")
       ->check(Positive("seconds"))
       ->type_name("SECONDS");
+  sub->add_option("--plots", options->plots_dir,
+                  "Write PNG plots into this folder: trajectory (top and side views), errors per "
+                  "axis with the +-3 sigma band, visibility stages, NEES, go/no-go (needs "
+                  "/usr/bin/python3 with python3-matplotlib)")
+      ->type_name("DIR");
   sub->callback([options]() { RunEvaluate(*options); });
 }
 

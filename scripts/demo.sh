@@ -13,4 +13,4 @@ mkdir -p "$out"
 build/bin/auvdock simulate --scenario data/scenarios/default.yaml --out "$out/dataset"
 build/bin/auvdock run --dataset "$out/dataset" --out "$out/run"
 build/bin/auvdock evaluate --dataset "$out/dataset" --estimate "$out/run/trajectory.tum" \
-  --covariance "$out/run/covariance.csv" --decisions "$out/run/decisions.csv"
+  --covariance "$out/run/covariance.csv" --decisions "$out/run/decisions.csv" --plots "$out/plots"

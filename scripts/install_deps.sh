@@ -9,6 +9,7 @@ packages=(
   libopencv-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   opencv-doc  # sample chessboards (examples/data/left*.jpg) for the PnP agreement tests
+  python3-matplotlib  # `evaluate --plots` (scripts/plot_run.py, run with /usr/bin/python3)
 )
 
 missing=()

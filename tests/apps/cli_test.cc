@@ -101,6 +101,50 @@ TEST_F(CliTest, EvaluatePrintsATableByDefault) {
   EXPECT_THAT(r.out, HasSubstr("stereo_only"));
 }
 
+// --plots: the five PNGs (scripts/plot_run.py, /usr/bin/python3 with matplotlib), with a
+// covariance for the first poses (the +-3 sigma band and the NEES) and no decisions.
+TEST_F(CliTest, EvaluateWritesThePlots) {
+  std::ifstream truth(dataset_ + "/groundtruth/data.csv");
+  std::string line;
+  std::getline(truth, line);  // header
+  std::string covariance = "#timestamp [ns],c00..c55\n";
+  for (int k = 0; k < 20 && std::getline(truth, line); ++k) {
+    covariance += line.substr(0, line.find(','));
+    for (int i = 0; i < 36; ++i) covariance += i % 7 == 0 ? ",1e-4" : ",0";
+    covariance += "\n";
+  }
+  const std::string covariance_path = *tmp_ / "covariance.csv";
+  test::WriteTextFile(covariance_path, covariance);
+  const std::string plots = *tmp_ / "plots";
+  const auto r = test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate",
+                                   dataset_ + "/groundtruth.tum", "--covariance",
+                                   covariance_path, "--plots", plots});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("plots: " + plots));
+  for (const char* name : {"trajectory.png", "errors.png", "stages.png", "nees.png",
+                           "go_no_go.png"}) {
+    std::ifstream png(plots + "/" + name, std::ios::binary);
+    char signature[4] = {};
+    png.read(signature, 4);
+    EXPECT_EQ(std::string(signature + 1, 3), "PNG") << name;
+    EXPECT_GT(fs::file_size(plots + "/" + name), 10000u) << name;
+  }
+}
+
+TEST_F(CliTest, PlotsThatCannotBeWrittenAreOneLineAndLeaveNothing) {
+  const std::string blocker = *tmp_ / "not_a_folder";
+  test::WriteTextFile(blocker, "x");
+  const auto r = test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate",
+                                   dataset_ + "/groundtruth.tum", "--plots", blocker});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_THAT(r.err, HasSubstr(blocker));
+  for (const auto& entry : fs::directory_iterator(tmp_->path())) {
+    EXPECT_EQ(entry.path().filename().string().rfind(".plots-", 0), std::string::npos)
+        << entry.path();
+  }
+}
+
 TEST_F(CliTest, MalformedEstimateIsOneLineAndExitTwo) {
   const std::string path = *tmp_ / "bad.tum";
   test::WriteTextFile(path, "1700000000.0 0 0 0 0 0 0 1\n1700000000.1 0 0 zero 0 0 0 1\n");
