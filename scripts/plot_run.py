@@ -194,6 +194,135 @@ def reason_class(reason):
     return ":".join(parts[:2]).strip() if len(parts) > 2 else text.strip()
 
 
+class Run:
+    """What the time plots show of one estimate (arrays over the estimates matched to truth)."""
+
+    def __init__(self, **fields):
+        self.__dict__.update(fields)
+
+
+def say_missing(ax, text):
+    ax.text(0.5, 0.5, text, ha="center", transform=ax.transAxes)
+
+
+def save(fig, staging, name, bottom):
+    """Stage legend below, tight layout above it, PNG into the staging folder."""
+    stage_legend(fig)
+    fig.tight_layout(rect=(0, bottom, 1, 1))
+    fig.savefig(os.path.join(staging, name), dpi=110)
+    plt.close(fig)
+
+
+def plot_trajectory(staging, label, p_truth, p_est, lights, deck):
+    fig, (top, side) = plt.subplots(2, 1, figsize=(9, 8))
+    for ax, j, name in ((top, 1, "y [m] (starboard)"), (side, 2, "z [m] (down)")):
+        ax.plot(p_truth[:, 0], p_truth[:, j], "k-", lw=1.2, label="truth")
+        ax.plot(p_est[:, 0], p_est[:, j], ".", ms=2.5, color="tab:blue", label=label)
+        ax.plot(lights[:, 0], lights[:, j], "o", ms=5, mfc="gold", mec="darkorange",
+                label="dock lights")
+        if deck and j == 1:
+            ax.add_patch(plt.Rectangle((-deck[0] / 2, -deck[1] / 2), deck[0], deck[1],
+                                       fill=False, ec="grey", ls="--", lw=0.8))
+        ax.set_xlabel("x [m] (docking axis)")
+        ax.set_ylabel(name)
+        ax.grid(alpha=0.3)
+    top.set_aspect("equal", adjustable="datalim")
+    side.invert_yaxis()
+    top.set_title("Trajectory in the dock frame D: top view")
+    side.set_title("side view")
+    top.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(staging, "trajectory.png"), dpi=110)
+    plt.close(fig)
+
+
+def plot_errors(staging, run):
+    """Position and attitude error per axis, with the reported +-3 sigma."""
+    fig, axes = plt.subplots(3, 2, figsize=(11, 8), sharex=True)
+    for i, axis in enumerate("xyz"):
+        for col, (err, scale, unit) in enumerate(((run.e_p, 1000.0, "mm"),
+                                                  (run.e_theta, 180.0 / math.pi, "deg"))):
+            ax = axes[i, col]
+            shade_stages(ax, run.stage_times, run.stages, run.t0)
+            ax.plot(run.t - run.t0, err[:, i] * scale, "-", lw=0.8, color="tab:blue")
+            limit = max(np.percentile(np.abs(err[:, i] * scale), 99) * 1.5, 1e-9)
+            if run.sigma is not None:
+                band = 3.0 * run.sigma[:, i + 3 * col] * scale
+                ax.plot(run.t - run.t0, band, "-", color="tab:red", lw=0.8,
+                        label="+-3 sigma (reported)")
+                ax.plot(run.t - run.t0, -band, "-", color="tab:red", lw=0.8)
+                limit = max(limit, np.nanpercentile(band, 50))
+            ax.axhline(0.0, color="k", lw=0.5)
+            ax.set_ylabel(f"{'position' if col == 0 else 'attitude'} {axis} [{unit}]")
+            ax.set_ylim(-limit, limit)
+            ax.grid(alpha=0.3)
+    for col in (0, 1):
+        axes[2, col].set_xlabel("time [s]")
+    axes[0, 0].set_title(f"{run.label}: position error (truth - estimate)")
+    axes[0, 1].set_title("attitude error Log(R_true R_est^T)")
+    if run.sigma is not None:
+        axes[0, 0].legend(fontsize=8, loc="upper right")
+    save(fig, staging, "errors.png", 0.04)
+
+
+def plot_stages(staging, run):
+    fig, ax = plt.subplots(figsize=(11, 3))
+    if run.stage_times is not None:
+        shade_stages(ax, run.stage_times, run.stages, run.t0)
+        for j, name in enumerate(("stereo left", "stereo right", "mono")):
+            ax.step(run.stage_times - run.t0, run.counts[:, j], where="post", lw=1.0, label=name)
+        ax.legend(fontsize=8, loc="upper left")
+    else:
+        say_missing(ax, "no groundtruth/visibility.csv in the dataset")
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel("lights in view")
+    ax.set_title("Visibility stages")
+    save(fig, staging, "stages.png", 0.08)
+
+
+def plot_nees(staging, run):
+    fig, ax = plt.subplots(figsize=(11, 3.5))
+    shade_stages(ax, run.stage_times, run.stages, run.t0)
+    if run.nees is not None:
+        ok = np.isfinite(run.nees)
+        ax.semilogy(run.t[ok] - run.t0, run.nees[ok], ".", ms=3, color="tab:blue",
+                    label="pose NEES")
+        ax.axhspan(*CHI2_6_95, color="tab:green", alpha=0.15, label="95 % of chi-square(6)")
+        ax.axhline(6.0, color="tab:green", lw=0.8)
+        ax.set_title(f"{run.label}: NEES of the reported covariance "
+                     f"(mean {np.mean(run.nees[ok]):.2f}, expected 6)")
+        ax.legend(fontsize=8, loc="upper right")
+    else:
+        say_missing(ax, "no covariance given (--covariance)")
+    ax.set_xlabel("time [s]")
+    ax.grid(alpha=0.3, which="both")
+    save(fig, staging, "nees.png", 0.06)
+
+
+def plot_go_no_go(staging, run):
+    fig, ax = plt.subplots(figsize=(11, 4))
+    if run.decisions is not None:
+        times, verdicts, reasons = run.decisions
+        classes = ["GO"] + sorted({reason_class(r) for v, r in zip(verdicts, reasons)
+                                   if v == "NO-GO"})
+        level = [0 if v == "GO" else classes.index(reason_class(r))
+                 for v, r in zip(verdicts, reasons)]
+        colours = ["tab:green" if v == "GO" else "tab:red" for v in verdicts]
+        shade_stages(ax, run.stage_times, run.stages, run.t0)
+        ax.scatter(times - run.t0, level, c=colours, s=6)
+        ax.set_yticks(range(len(classes)))
+        ax.set_yticklabels([c if len(c) < 70 else c[:67] + "..." for c in classes], fontsize=7)
+        ax.invert_yaxis()
+        go = sum(v == "GO" for v in verdicts)
+        ax.set_title(f"{run.label}: go/no-go ({go} GO of {len(verdicts)} decisions; "
+                     "NO-GO by reason)")
+    else:
+        say_missing(ax, "no decisions given (--decisions)")
+    ax.set_xlabel("time [s]")
+    ax.grid(alpha=0.3, axis="x")
+    save(fig, staging, "go_no_go.png", 0.06)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--dataset", required=True, help="dataset folder with groundtruth.tum")
@@ -264,133 +393,18 @@ def main():
         if not np.any(has):
             raise InputError(f"{args.covariance}: no row has the time stamp of an estimate")
 
-    t0 = t_truth[0]
+    run = Run(label=args.label, t0=t_truth[0], t=t, e_p=e_p, e_theta=e_theta, sigma=sigma,
+              nees=nees, stage_times=stage_times, stages=stages, counts=counts,
+              decisions=decisions)
     parent = os.path.dirname(os.path.abspath(args.out))
     os.makedirs(parent, exist_ok=True)
     staging = tempfile.mkdtemp(prefix=".plots-", dir=parent)
     try:
-        # Trajectory: top and side views.
-        fig, (top, side) = plt.subplots(2, 1, figsize=(9, 8))
-        for ax, j, name in ((top, 1, "y [m] (starboard)"), (side, 2, "z [m] (down)")):
-            ax.plot(p_truth[:, 0], p_truth[:, j], "k-", lw=1.2, label="truth")
-            ax.plot(p_est[:, 0], p_est[:, j], ".", ms=2.5, color="tab:blue", label=args.label)
-            ax.plot(lights[:, 0], lights[:, j], "o", ms=5, mfc="gold", mec="darkorange",
-                    label="dock lights")
-            if deck and j == 1:
-                ax.add_patch(plt.Rectangle((-deck[0] / 2, -deck[1] / 2), deck[0], deck[1],
-                                           fill=False, ec="grey", ls="--", lw=0.8))
-            ax.set_xlabel("x [m] (docking axis)")
-            ax.set_ylabel(name)
-            ax.grid(alpha=0.3)
-        top.set_aspect("equal", adjustable="datalim")
-        side.invert_yaxis()
-        top.set_title("Trajectory in the dock frame D: top view")
-        side.set_title("side view")
-        top.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(os.path.join(staging, "trajectory.png"), dpi=110)
-        plt.close(fig)
-
-        # Errors per axis with the +-3 sigma band.
-        fig, axes = plt.subplots(3, 2, figsize=(11, 8), sharex=True)
-        labels = ["x", "y", "z"]
-        for i in range(3):
-            for col, (err, scale, unit) in enumerate(((e_p, 1000.0, "mm"),
-                                                      (e_theta, 180.0 / math.pi, "deg"))):
-                ax = axes[i, col]
-                shade_stages(ax, stage_times, stages, t0)
-                ax.plot(t - t0, err[:, i] * scale, "-", lw=0.8, color="tab:blue")
-                if sigma is not None:
-                    band = 3.0 * sigma[:, i + 3 * col] * scale
-                    ax.plot(t - t0, band, "-", color="tab:red", lw=0.8,
-                            label="+-3 sigma (reported)")
-                    ax.plot(t - t0, -band, "-", color="tab:red", lw=0.8)
-                ax.axhline(0.0, color="k", lw=0.5)
-                ax.set_ylabel(f"{'position' if col == 0 else 'attitude'} {labels[i]} [{unit}]")
-                ax.grid(alpha=0.3)
-                finite = np.abs(err[:, i] * scale)
-                limit = np.percentile(finite, 99) * 1.5 if len(finite) else 1.0
-                if sigma is not None:
-                    limit = max(limit, np.nanpercentile(3.0 * sigma[:, i + 3 * col] * scale, 50))
-                ax.set_ylim(-limit, limit)
-        axes[2, 0].set_xlabel("time [s]")
-        axes[2, 1].set_xlabel("time [s]")
-        axes[0, 0].set_title(f"{args.label}: position error (truth - estimate)")
-        axes[0, 1].set_title("attitude error Log(R_true R_est^T)")
-        if sigma is not None:
-            axes[0, 0].legend(fontsize=8, loc="upper right")
-        stage_legend(fig)
-        fig.tight_layout(rect=(0, 0.04, 1, 1))
-        fig.savefig(os.path.join(staging, "errors.png"), dpi=110)
-        plt.close(fig)
-
-        # Visibility stages.
-        fig, ax = plt.subplots(figsize=(11, 3))
-        if stage_times is not None:
-            shade_stages(ax, stage_times, stages, t0)
-            for j, name in enumerate(("stereo left", "stereo right", "mono")):
-                ax.step(stage_times - t0, counts[:, j], where="post", lw=1.0, label=name)
-            ax.legend(fontsize=8, loc="upper left")
-            stage_legend(fig)
-        else:
-            ax.text(0.5, 0.5, "no groundtruth/visibility.csv in the dataset", ha="center",
-                    transform=ax.transAxes)
-        ax.set_xlabel("time [s]")
-        ax.set_ylabel("lights in view")
-        ax.set_title("Visibility stages")
-        fig.tight_layout(rect=(0, 0.08, 1, 1))
-        fig.savefig(os.path.join(staging, "stages.png"), dpi=110)
-        plt.close(fig)
-
-        # NEES.
-        fig, ax = plt.subplots(figsize=(11, 3.5))
-        shade_stages(ax, stage_times, stages, t0)
-        if nees is not None:
-            ok = np.isfinite(nees)
-            ax.semilogy(t[ok] - t0, nees[ok], ".", ms=3, color="tab:blue", label="pose NEES")
-            ax.axhspan(*CHI2_6_95, color="tab:green", alpha=0.15, label="95 % of chi-square(6)")
-            ax.axhline(6.0, color="tab:green", lw=0.8)
-            ax.set_title(f"{args.label}: NEES of the reported covariance "
-                         f"(mean {np.mean(nees[ok]):.2f}, expected 6)")
-            ax.legend(fontsize=8, loc="upper right")
-        else:
-            ax.text(0.5, 0.5, "no covariance given (--covariance)", ha="center",
-                    transform=ax.transAxes)
-        ax.set_xlabel("time [s]")
-        ax.grid(alpha=0.3, which="both")
-        stage_legend(fig)
-        fig.tight_layout(rect=(0, 0.06, 1, 1))
-        fig.savefig(os.path.join(staging, "nees.png"), dpi=110)
-        plt.close(fig)
-
-        # Go / no-go.
-        fig, ax = plt.subplots(figsize=(11, 4))
-        if decisions is not None:
-            times, verdicts, reasons = decisions
-            classes = ["GO"] + sorted({reason_class(r) for v, r in zip(verdicts, reasons)
-                                       if v == "NO-GO"})
-            level = [0 if v == "GO" else classes.index(reason_class(r))
-                     for v, r in zip(verdicts, reasons)]
-            colours = ["tab:green" if v == "GO" else "tab:red" for v in verdicts]
-            shade_stages(ax, stage_times, stages, t0)
-            ax.scatter(times - t0, level, c=colours, s=6)
-            ax.set_yticks(range(len(classes)))
-            ax.set_yticklabels([c if len(c) < 70 else c[:67] + "..." for c in classes],
-                               fontsize=7)
-            ax.invert_yaxis()
-            go = sum(v == "GO" for v in verdicts)
-            ax.set_title(f"{args.label}: go/no-go ({go} GO of {len(verdicts)} decisions; "
-                         "NO-GO by reason)")
-        else:
-            ax.text(0.5, 0.5, "no decisions given (--decisions)", ha="center",
-                    transform=ax.transAxes)
-        ax.set_xlabel("time [s]")
-        ax.grid(alpha=0.3, axis="x")
-        stage_legend(fig)
-        fig.tight_layout(rect=(0, 0.06, 1, 1))
-        fig.savefig(os.path.join(staging, "go_no_go.png"), dpi=110)
-        plt.close(fig)
-
+        plot_trajectory(staging, args.label, p_truth, p_est, lights, deck)
+        plot_errors(staging, run)
+        plot_stages(staging, run)
+        plot_nees(staging, run)
+        plot_go_no_go(staging, run)
         os.makedirs(args.out, exist_ok=True)
         for name in os.listdir(staging):
             os.replace(os.path.join(staging, name), os.path.join(args.out, name))
