@@ -3,9 +3,9 @@
 // --covariance the consistency of the reported covariances (NEES).
 // The metrics are defined in include/auvdock/eval/trajectory_evaluation.h.
 #include <cmath>
-#include <filesystem>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>

@@ -18,9 +18,9 @@
 // decimetres of the lens, or a large bright structure) are judged after all others and suppress
 // none of them: one is kept only if no kept light lies within halo_extent_sigmas of its sigma (a
 // light that close outshines the others and is far from them in the image; a white funnel's
-// plateau has the dock's lights round it). A detection whose halo ring leaves the image is flagged at_border
-// and its covariance widened by (border_sigma_fraction sigma)^2 per axis: the cut biases the
-// centroid by a fraction of the light's size.
+// plateau has the dock's lights round it). A detection whose halo ring leaves the image is
+// flagged at_border and its covariance widened by (border_sigma_fraction sigma)^2 per axis: the
+// cut biases the centroid by a fraction of the light's size.
 //
 // Score in [0, 1]: the geometric mean of response / score_response and halo_excess /
 // (2 min_halo_excess) (1 for white lights), each clamped to [0, 1].
