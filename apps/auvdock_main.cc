@@ -4,10 +4,13 @@
 // unexpected internal error, 130 when interrupted.
 #include <cstdio>
 #include <exception>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "apps/commands.h"
+#include "apps/unknown_words.h"
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/cancellation.h"
 
@@ -23,6 +26,12 @@ int main(int argc, char** argv) {
   auvdock::cli::AddSmoothCommand(app);
   auvdock::cli::AddDetectCommand(app);
 
+  const std::string unknown =
+      auvdock::cli::UnknownWordMessage(app, std::vector<std::string>(argv + 1, argv + argc));
+  if (!unknown.empty()) {
+    std::fprintf(stderr, "auvdock: error: %s\n", unknown.c_str());
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

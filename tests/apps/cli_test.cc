@@ -154,6 +154,25 @@ TEST_F(CliTest, MalformedEstimateIsOneLineAndExitTwo) {
   EXPECT_THAT(r.err, AllOf(HasSubstr(path), HasSubstr("line 2")));
 }
 
+// A typo is named, with the closest valid word, before anything it leaves missing.
+TEST(Cli, UnknownWordsNameThemselvesAndTheClosestValidOne) {
+  const auto sub = test::RunAuvdock({"rnu", "--dataset", "x"});
+  EXPECT_EQ(sub.exit_status, 2);
+  EXPECT_EQ(CountLines(sub.err), 1) << sub.err;
+  EXPECT_THAT(sub.err, AllOf(HasSubstr("unknown subcommand 'rnu'"), HasSubstr("'run'?")));
+  const auto option = test::RunAuvdock({"run", "--datset", "x"});
+  EXPECT_EQ(option.exit_status, 2);
+  EXPECT_EQ(CountLines(option.err), 1) << option.err;
+  EXPECT_THAT(option.err,
+              AllOf(HasSubstr("unknown option '--datset' of 'run'"), HasSubstr("'--dataset'?")));
+  const auto with_value = test::RunAuvdock({"evaluate", "--plot=out", "--dataset", "x"});
+  EXPECT_THAT(with_value.err, AllOf(HasSubstr("'--plot'"), HasSubstr("'--plots'?")));
+  const auto far = test::RunAuvdock({"simulate", "--xyzzy"});
+  EXPECT_THAT(far.err, AllOf(HasSubstr("'--xyzzy'"), HasSubstr("simulate --help")));
+  // Known words pass to the parser: its own message for what is missing.
+  EXPECT_THAT(test::RunAuvdock({"run"}).err, HasSubstr("--dataset"));
+}
+
 TEST(Cli, UsageErrorsExitTwo) {
   EXPECT_EQ(test::RunAuvdock({}).exit_status, 2);
   EXPECT_EQ(test::RunAuvdock({"frobnicate"}).exit_status, 2);
