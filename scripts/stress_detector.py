@@ -4,7 +4,8 @@
 Makes perturbed copies of labelled frames and measures `auvdock detect --labels` on each:
 a closer or farther view (zoom about the image centre, with the calibration's focal lengths and
 principal point changed to match: the distortion, in normalised coordinates, stays the same, so
-the poses stay comparable), exposure (gain), defocus blur, JPEG quality and sensor noise. The
+the poses stay comparable), exposure (gain), a tone curve (gamma), limited-range video levels
+(16-235 shown as full range), defocus blur, JPEG quality and sensor noise. The
 labels move with the zoom; a label the zoom pushes out of the image becomes `edge` (not
 required), one within the border margin `border`.
 
@@ -36,6 +37,8 @@ VARIANTS = {
     "zoom2.0": {"zoom": 2.0},
     "gain0.6": {"gain": 0.6},
     "gain1.4": {"gain": 1.4},
+    "videorange": {"levels": (16, 235)},
+    "gamma0.6": {"gamma": 0.6},
     "blur1.2": {"blur": 1.2},
     "jpeg40": {"jpeg": 40},
     "noise6": {"noise": 6.0},
@@ -101,6 +104,11 @@ def make_variant(args, name, effect, labels, folder, cv2, np):
             work = cv2.warpAffine(work, warp, size, flags=cv2.INTER_LINEAR,
                                   borderMode=cv2.BORDER_REPLICATE)
         work *= effect.get("gain", 1.0)
+        if "gamma" in effect:  # a tone curve: out = 255 (in / 255)^gamma
+            work = 255.0 * np.power(np.clip(work, 0, 255) / 255.0, effect["gamma"])
+        if "levels" in effect:  # limited-range video shown as full range: black 16, white 235
+            black, white = effect["levels"]
+            work = black + np.clip(work, 0, 255) * (white - black) / 255.0
         if effect.get("blur", 0.0) > 0.0:
             work = cv2.GaussianBlur(work, (0, 0), effect["blur"])
         if effect.get("noise", 0.0) > 0.0:

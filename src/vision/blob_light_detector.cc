@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "auvdock/vision/field_deinterlace.h"
+#include "auvdock/vision/image_levels.h"
 
 namespace auvdock {
 namespace {
@@ -15,18 +16,6 @@ double Clamp01(double v) { return std::clamp(v, 0.0, 1.0); }
 
 }  // namespace
 
-double EstimatePixelNoise(const cv::Mat& luma) {
-  std::vector<float> diffs;
-  diffs.reserve(static_cast<size_t>(luma.rows / 4 + 1) * luma.cols);
-  for (int y = 0; y < luma.rows; y += 4) {
-    const float* row = luma.ptr<float>(y);
-    for (int x = 1; x < luma.cols; ++x) diffs.push_back(std::abs(row[x] - row[x - 1]));
-  }
-  if (diffs.empty()) return 1.0;
-  std::nth_element(diffs.begin(), diffs.begin() + diffs.size() / 2, diffs.end());
-  return std::max(0.5, diffs[diffs.size() / 2] / (0.6745 * std::sqrt(2.0)));
-}
-
 BlobLightDetector::BlobLightDetector(const BlobLightDetectorOptions& options) : options_(options) {
   const auto& c = options.core;
   if (!(c.core_level > 0.0 && c.core_level < 1.0) || !(c.window_sigmas > 0.0) ||
@@ -34,17 +23,16 @@ BlobLightDetector::BlobLightDetector(const BlobLightDetectorOptions& options) : 
       !(c.floor_px >= 0.0) || !(options.min_separation_px >= 0.0) ||
       !(options.border_sigma_fraction >= 0.0) || options.max_detections < 1 ||
       !(options.halo_extent_sigmas >= 0.0) || !(options.max_response_in_halo >= 0.0) ||
-      !(options.checks.halo_radius_sigmas > 0.0) ||
-      !(options.checks.max_core_elongation >= 1.0) ||
+      !(options.checks.halo_radius_sigmas > 0.0) || !(options.checks.max_core_elongation >= 1.0) ||
       !(options.checks.max_core_stretch_px >= 0.0) || !(options.close_light_min_sigma_px > 0.0)) {
     throw std::invalid_argument("BlobLightDetectorOptions out of range");
   }
   FindBlobCandidates(cv::Mat::zeros(16, 16, CV_32F), options.candidates);  // checks its options
 }
 
-std::vector<LightDetection> BlobLightDetector::Detect(
-    const cv::Mat& image, std::vector<RejectedLightCandidate>* rejected,
-    std::optional<double> min_halo_excess) const {
+std::vector<LightDetection> BlobLightDetector::Detect(const cv::Mat& image,
+                                                      std::vector<RejectedLightCandidate>* rejected,
+                                                      std::optional<double> min_halo_excess) const {
   if (image.empty() || (image.type() != CV_8UC3 && image.type() != CV_8UC1)) {
     throw std::invalid_argument("BlobLightDetector: expected a non-empty CV_8UC3 or CV_8UC1 image");
   }
@@ -68,7 +56,17 @@ std::vector<LightDetection> BlobLightDetector::Detect(
   std::vector<Kept> kept;
   LightCandidateCheckOptions checks = options_.checks;
   if (min_halo_excess) checks.min_halo_excess = *min_halo_excess;
-  std::vector<BlobCandidate> candidates = FindBlobCandidates(luma, options_.candidates);
+  // An image that clips below 255 (limited-range video, a gain past the clip) saturates there,
+  // and its contrasts are those of a full-range image scaled by clip / 255.
+  BlobCandidateOptions candidate_options = options_.candidates;
+  double score_response = options_.score_response;
+  if (const std::optional<double> clip = EstimateClipLevel(luma, source)) {
+    checks.saturation_level =
+        std::min(checks.saturation_level, *clip - (255.0 - options_.checks.saturation_level));
+    candidate_options.min_response *= std::min(1.0, *clip / 255.0);
+    score_response *= std::min(1.0, *clip / 255.0);
+  }
+  std::vector<BlobCandidate> candidates = FindBlobCandidates(luma, candidate_options);
   std::stable_partition(candidates.begin(), candidates.end(), [&](const BlobCandidate& c) {
     return c.sigma_px <= options_.close_light_min_sigma_px;
   });
@@ -83,11 +81,9 @@ std::vector<LightDetection> BlobLightDetector::Detect(
       reject(at, "no contrast");
       continue;
     }
-    const LightCandidateEvidence evidence =
-        MeasureCandidateEvidence(source, luma, *core, candidate.sigma_px, background_excess,
-                                 options_.checks);
-    const std::string reason =
-        CheckLightCandidate(candidate, *core, evidence, has_colour, checks);
+    const LightCandidateEvidence evidence = MeasureCandidateEvidence(
+        source, luma, *core, candidate.sigma_px, background_excess, checks);
+    const std::string reason = CheckLightCandidate(candidate, *core, evidence, has_colour, checks);
     if (!reason.empty()) {
       reject(core->uv, reason);
       continue;
@@ -95,8 +91,8 @@ std::vector<LightDetection> BlobLightDetector::Detect(
     std::string overlap;
     const bool close_light = candidate.sigma_px > options_.close_light_min_sigma_px;
     for (const Kept& k : kept) {
-      if (close_light && (k.detection.uv - core->uv).norm() <
-                             options_.halo_extent_sigmas * candidate.sigma_px) {
+      if (close_light &&
+          (k.detection.uv - core->uv).norm() < options_.halo_extent_sigmas * candidate.sigma_px) {
         overlap = "larger than a light among lights";
         break;
       }
@@ -121,7 +117,7 @@ std::vector<LightDetection> BlobLightDetector::Detect(
     d.uv = core->uv;
     d.radius_px = std::max(core->radius_px, candidate.sigma_px);
     d.peak = core->peak;
-    const double strength = Clamp01(candidate.response / options_.score_response);
+    const double strength = Clamp01(candidate.response / score_response);
     const double colour = has_colour && options_.checks.colour != LightColour::kWhite
                               ? Clamp01(evidence.halo_excess / (2.0 * checks.min_halo_excess))
                               : 1.0;

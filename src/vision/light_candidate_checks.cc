@@ -136,13 +136,13 @@ std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore&
   const double max_elongation =
       std::min(options.max_core_elongation, std::sqrt(1.0 + stretch * stretch / 3.0));
   if (core.elongation > max_elongation && core.area_px >= 12) return "elongated";
-  if (evidence.peak_drop < options.min_peak_drop ||
-      (!evidence.saturated &&
-       evidence.peak_drop < options.min_peak_drop_fraction * (core.peak - core.floor))) {
-    return "not a peak";
-  }
-  if (evidence.saturated &&
-      evidence.open_drop < options.min_open_drop_fraction * (core.peak - core.floor)) {
+  // A core cut from a structure by the opening has that structure in part of its ring: like a
+  // saturated light beside a bright surface, it must drop in the open sectors, not in all.
+  const bool structure_beside = evidence.saturated || core.separated;
+  const double contrast = core.peak - core.floor;
+  if ((!core.separated && evidence.peak_drop < options.min_peak_drop) ||
+      (!structure_beside && evidence.peak_drop < options.min_peak_drop_fraction * contrast) ||
+      (structure_beside && evidence.open_drop < options.min_open_drop_fraction * contrast)) {
     return "not a peak";
   }
   if (!evidence.saturated && candidate.sigma_px >= options.min_flat_sigma_px &&

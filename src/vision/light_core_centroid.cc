@@ -4,6 +4,8 @@
 #include <cmath>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
 namespace auvdock {
 
 std::optional<LightCore> MeasureLightCore(const cv::Mat& luma, int x, int y, double sigma_px,
@@ -22,8 +24,8 @@ std::optional<LightCore> MeasureLightCore(const cv::Mat& luma, int x, int y, dou
     values.insert(values.end(), row + x0, row + x1 + 1);
   }
   std::vector<float> sorted = values;
-  const size_t k = std::min(sorted.size() - 1,
-                            static_cast<size_t>(options.floor_percentile * sorted.size()));
+  const size_t k =
+      std::min(sorted.size() - 1, static_cast<size_t>(options.floor_percentile * sorted.size()));
   std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
   const double floor = sorted[k];
 
@@ -45,22 +47,20 @@ std::optional<LightCore> MeasureLightCore(const cv::Mat& luma, int x, int y, dou
   }
   const double peak = best;
   if (!(peak > floor)) return std::nullopt;
-  // Flood fill (8-connected) from the seed over pixels at or above the threshold; a core that
-  // reaches the window's edge has run into a bright structure next to the light (a lit funnel
-  // rim): the level rises towards the peak until the core is compact.
+  // Flood fill (8-connected) from the seed over pixels at or above the threshold (and, when
+  // given, inside a mask); a core that reaches the window's edge has run into a bright structure
+  // next to the light (a lit funnel rim): the level rises towards the peak until the core is
+  // compact.
   LightCore core;
-  double threshold = 0.0;
   std::vector<int> members;
   std::vector<unsigned char> in_core(values.size(), 0);
-  for (const double level : {options.core_level, 0.5 * (1.0 + options.core_level),
-                             0.25 * (3.0 + options.core_level)}) {
-    threshold = floor + level * (peak - floor);
+  auto flood = [&](int seed, double threshold, const cv::Mat& allowed) {
     std::fill(in_core.begin(), in_core.end(), 0);
     members.clear();
     core.touches_window = false;
     core.touches_border = false;
-    std::vector<int> stack{sy * w + sx};
-    in_core[sy * w + sx] = 1;
+    std::vector<int> stack{seed};
+    in_core[seed] = 1;
     while (!stack.empty()) {
       const int i = stack.back();
       stack.pop_back();
@@ -80,12 +80,57 @@ std::optional<LightCore> MeasureLightCore(const cv::Mat& luma, int x, int y, dou
           if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
           const int j = ny * w + nx;
           if (in_core[j] || values[j] < threshold) continue;
+          if (!allowed.empty() && !allowed.at<unsigned char>(ny, nx)) continue;
           in_core[j] = 1;
           stack.push_back(j);
         }
       }
     }
+  };
+  double threshold = 0.0;
+  for (const double level :
+       {options.core_level, 0.5 * (1.0 + options.core_level), 0.25 * (3.0 + options.core_level)}) {
+    threshold = floor + level * (peak - floor);
+    flood(sy * w + sx, threshold, cv::Mat());
     if (!core.touches_window) break;
+  }
+  if (core.touches_window && options.neck_cut_sigmas > 0.0 &&
+      sigma_px <= options.max_neck_cut_sigma_px) {
+    // Still joined to a structure at the highest level (both clipped, or the light's plateau
+    // running into a lit rim): open the core mask with a disc of radius neck_cut_sigmas sigma,
+    // which cuts necks and rims narrower than its diameter and keeps a disc of the light's size.
+    cv::Mat mask(h, w, CV_8U);
+    for (int i = 0; i < w * h; ++i) mask.data[i] = values[i] >= threshold ? 255 : 0;
+    const int k = std::max(1, static_cast<int>(std::lround(options.neck_cut_sigmas * sigma_px)));
+    cv::Mat opened;
+    cv::morphologyEx(mask, opened, cv::MORPH_OPEN,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * k + 1, 2 * k + 1)));
+    // The opened pixel nearest the seed, within the search radius.
+    int seed = -1;
+    double nearest = search * search;
+    for (int yy = 0; yy < h; ++yy) {
+      for (int xx = 0; xx < w; ++xx) {
+        if (!opened.at<unsigned char>(yy, xx)) continue;
+        const double d2 = (xx - sx) * (xx - sx) + (yy - sy) * (yy - sy);
+        if (d2 <= nearest) {
+          nearest = d2;
+          seed = yy * w + xx;
+        }
+      }
+    }
+    if (seed >= 0) {
+      const std::vector<int> joined = members;
+      const bool joined_border = core.touches_border;
+      flood(seed, threshold, opened);
+      if (core.touches_window) {
+        members = joined;  // not separable: the joined core stands, and is judged extended
+        core.touches_window = true;
+        core.touches_border = joined_border;
+      } else {
+        core.separated = true;
+        core.separation_px = k;
+      }
+    }
   }
   double sw = 0.0, su = 0.0, sv = 0.0;
   // Weights above the threshold; a flat (clipped) core gets a small uniform weight so that its
@@ -112,6 +157,12 @@ std::optional<LightCore> MeasureLightCore(const cv::Mat& luma, int x, int y, dou
   core.covariance = noise_sigma * noise_sigma * noise_term / (sw * sw) +
                     options.shape_fraction * options.shape_fraction * moment +
                     options.floor_px * options.floor_px * Eigen::Matrix2d::Identity();
+  if (core.separated) {
+    // What the opening left of the junction with the structure pulls the centre towards it by a
+    // fraction of the opening's radius.
+    const double s = options.separated_bias_fraction * core.separation_px;
+    core.covariance += s * s * Eigen::Matrix2d::Identity();
+  }
   core.peak = peak;
   core.floor = floor;
   core.area_px = static_cast<int>(members.size());

@@ -10,17 +10,19 @@
 // clutter the colour check. It was developed on real pool footage (a white funnel ringed by blue
 // LEDs) and randomised renders.
 //
-// Pipeline per image: optional field deinterlacing (field_deinterlace.h) -> luma (BT.601) ->
-// candidates -> per candidate: core, evidence, checks -> detections closer than the larger
-// core radius (at least min_separation_px) to a stronger one are the same light, and much weaker
-// ones in a stronger light's halo are its glow (halo_extent_sigmas, max_response_in_halo) -> at most
-// max_detections by score. Candidates at scales above close_light_min_sigma_px (a light within
-// decimetres of the lens, or a large bright structure) are judged after all others and suppress
-// none of them: one is kept only if no kept light lies within halo_extent_sigmas of its sigma (a
-// light that close outshines the others and is far from them in the image; a white funnel's
-// plateau has the dock's lights round it). A detection whose halo ring leaves the image is
-// flagged at_border and its covariance widened by (border_sigma_fraction sigma)^2 per axis: the
-// cut biases the centroid by a fraction of the light's size.
+// Pipeline per image: optional field deinterlacing (field_deinterlace.h) -> luma (BT.601) -> its
+// noise and clip level (image_levels.h: an image clipping at L < 255 saturates at L - (255 -
+// checks.saturation_level), and its contrasts are scaled by L / 255, the response thresholds
+// min_response and score_response with them) -> candidates -> per candidate: core, evidence, checks -> detections
+// closer than the larger core radius (at least min_separation_px) to a stronger one are the same
+// light, and much weaker ones in a stronger light's halo are its glow (halo_extent_sigmas,
+// max_response_in_halo) -> at most max_detections by score. Candidates at scales above
+// close_light_min_sigma_px (a light within decimetres of the lens, or a large bright structure) are
+// judged after all others and suppress none of them: one is kept only if no kept light lies within
+// halo_extent_sigmas of its sigma (a light that close outshines the others and is far from them in
+// the image; a white funnel's plateau has the dock's lights round it). A detection whose halo ring
+// leaves the image is flagged at_border and its covariance widened by (border_sigma_fraction
+// sigma)^2 per axis: the cut biases the centroid by a fraction of the light's size.
 //
 // Score in [0, 1]: the geometric mean of response / score_response and halo_excess /
 // (2 min_halo_excess) (1 for white lights), each clamped to [0, 1].
@@ -93,9 +95,5 @@ class BlobLightDetector {
  private:
   BlobLightDetectorOptions options_;
 };
-
-// Robust per-pixel noise sigma of a CV_32FC1 image (gray levels): from the median absolute
-// difference of horizontal neighbours on every 4th row, sigma = MAD / (0.6745 sqrt(2)).
-double EstimatePixelNoise(const cv::Mat& luma);
 
 }  // namespace auvdock

@@ -9,7 +9,15 @@
 // When that core reaches the window's edge it has run into a bright structure beside the light
 // (a lit funnel rim): the level is raised to (1 + core_level) / 2, then (3 + core_level) / 4.
 // A high core_level keeps the centre on the emitting core and off the halo and any bright
-// structure the halo touches (a lit funnel rim pulls a low-level centroid by pixels).
+// structure the halo touches (a lit funnel rim pulls a low-level centroid by pixels). A core that
+// still reaches the window's edge at the highest level (a light clipped together with the
+// structure it touches: overexposure) is cut from it by a morphological opening of its mask with
+// a disc of radius k = neck_cut_sigmas sigma: a light's disc (radius ~sqrt(2) sigma at its blob
+// scale) survives it, a neck or rim narrower than 2k does not. A core so separated is marked
+// separated, and what the opening leaves of the junction may pull its centre towards the
+// structure: its covariance grows by (separated_bias_fraction k)^2 per axis. Only at scales up to
+// max_neck_cut_sigma_px: a larger opening carves lobes out of a structure itself (a white funnel's
+// interior split by its vanes), and a light that large outshines any rim it touches.
 //
 // Covariance (pixels^2), three parts:
 //   * pixel noise: sigma_n^2 sum (x_i - c)(x_i - c)^T / W^2 (the centroid's linear error
@@ -37,6 +45,9 @@ struct LightCoreOptions {
   double search_sigmas = 1.0;     // the brightest pixel within this of the candidate
   double shape_fraction = 0.15;
   double floor_px = 0.1;
+  double neck_cut_sigmas = 0.7;  // 0: no separation
+  double max_neck_cut_sigma_px = 16.0;
+  double separated_bias_fraction = 0.25;
 };
 
 struct LightCore {
@@ -51,6 +62,8 @@ struct LightCore {
   double elongation = 1.0;
   bool touches_window = false;  // the core reaches the window's edge (not a compact core)
   bool touches_border = false;  // the core reaches the image's edge (cut: its centre is biased)
+  bool separated = false;       // cut from a bright structure by the opening (see above)
+  double separation_px = 0.0;   // the opening's radius k when separated
 };
 
 // luma: CV_32FC1. (x, y) the candidate pixel, sigma_px its scale, noise_sigma the image's pixel
