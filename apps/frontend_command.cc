@@ -1,4 +1,4 @@
-// auvdock frontend --dataset DIR --out OUTDIR [--dehaze] [--no-tracking]
+// auvdock frontend --dataset DIR [--dock FILE] --out OUTDIR [--dehaze] [--no-tracking]
 //                  [--matcher ransac|omnidirectional] [--detector contrast|blob]
 //
 // Runs the paper's per-frame pipeline (PaperBaselinePipeline) over every camera frame and
@@ -23,6 +23,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "apps/commands.h"
+#include "apps/dataset_input.h"
 #include "apps/reason_class.h"
 #include "apps/signal_flag.h"
 #include "auvdock/io/csv.h"
@@ -41,6 +42,7 @@ namespace {
 
 struct FrontendOptions {
   std::string dataset;
+  std::string dock;  // --dock: replaces the dataset's dock.yaml
   std::string out;
   bool dehaze = false;
   bool no_tracking = false;
@@ -73,10 +75,8 @@ cv::Mat ReadImage(const CameraFrame& frame, const CameraCalibration& camera, int
 }
 
 void RunFrontend(const FrontendOptions& options) {
-  const Dataset dataset = LoadDataset(options.dataset);
-  if (!dataset.dock) {
-    throw InputError(options.dataset + ": no dock.yaml: the front-end identifies the dock's lights");
-  }
+  const Dataset dataset = LoadDatasetWithDock(options.dataset, options.dock);
+  RequireDock(dataset);
   PaperBaselineOptions pipeline_options;
   pipeline_options.detector.dehaze = options.dehaze;
   pipeline_options.use_tracking = !options.no_tracking;
@@ -190,6 +190,7 @@ void AddFrontendCommand(CLI::App& root) {
   CLI::App* sub = root.add_subcommand(
       "frontend", "Per-frame vision (the paper's pipeline): detections, stages, per-frame poses");
   sub->add_option("--dataset", options->dataset, "Dataset folder")->required();
+  AddDockOption(sub, &options->dock);
   sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
   sub->add_flag("--dehaze", options->dehaze, "Dark-channel dehazing before detection");
   sub->add_flag("--no-tracking", options->no_tracking,

@@ -1,4 +1,4 @@
-// auvdock run --dataset DIR --out OUTDIR [--config FILE] [--quiet]
+// auvdock run --dataset DIR [--dock FILE] --out OUTDIR [--config FILE] [--quiet]
 //
 // Causal sliding-window estimation over a dataset (SlidingWindowEstimator): every camera frame
 // goes through the per-frame vision pipeline, then into the estimator together with the IMU
@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "apps/commands.h"
+#include "apps/dataset_input.h"
 #include "apps/estimate_writer.h"
 #include "apps/run_summary.h"
 #include "apps/sensor_feed.h"
@@ -26,6 +27,7 @@ namespace {
 
 struct RunOptions {
   std::string dataset;
+  std::string dock;  // --dock: replaces the dataset's dock.yaml
   std::string out;
   std::string config;
   bool quiet = false;
@@ -41,11 +43,11 @@ void Run(const RunOptions& options) {
   const auto start = Clock::now();
   const RunConfig config = options.config.empty() ? RunConfig{} : LoadRunConfig(options.config);
   std::vector<std::string> skipped_rows;
-  const Dataset dataset = LoadDataset(options.dataset, &skipped_rows);
+  const Dataset dataset = LoadDatasetWithDock(options.dataset, options.dock, &skipped_rows);
   if (!dataset.calibration.imu) throw InputError(options.dataset + ": calibration has no IMU");
   VisionFrameSource source(dataset, ParseDetectorKind(options.detector),
                            SyncToleranceNs(options.sync_tolerance_ms), options.detections);
-  SlidingWindowEstimator estimator(dataset.calibration, *dataset.dock, config.estimator);
+  SlidingWindowEstimator estimator(dataset.calibration, RequireDock(dataset), config.estimator);
   GoNoGo go_no_go(config.go_no_go);
   EstimateWriter writer(options.out);
   for (const std::string& row : skipped_rows) std::fprintf(stderr, "auvdock: run: %s\n", row.c_str());
@@ -121,6 +123,7 @@ void AddRunCommand(CLI::App& root) {
   CLI::App* sub = root.add_subcommand(
       "run", "Causal sliding-window estimation: trajectory, covariance, go/no-go decisions");
   sub->add_option("--dataset", options->dataset, "Dataset folder")->required();
+  AddDockOption(sub, &options->dock);
   sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
   sub->add_option("--config", options->config, "Estimator and go/no-go options (YAML)");
   sub->add_option("--detector", options->detector,

@@ -1,4 +1,4 @@
-// auvdock smooth --dataset DIR --out OUTDIR [--config FILE] [--quiet]
+// auvdock smooth --dataset DIR [--dock FILE] --out OUTDIR [--config FILE] [--quiet]
 //
 // Offline reconstruction of a whole log (SmoothBatch): the per-frame vision pipeline and the
 // causal sliding-window run first (their states are the warm start), then every state in one
@@ -11,6 +11,7 @@
 #include <set>
 
 #include "apps/commands.h"
+#include "apps/dataset_input.h"
 #include "apps/estimate_writer.h"
 #include "apps/run_summary.h"
 #include "apps/sensor_feed.h"
@@ -26,6 +27,7 @@ namespace {
 
 struct SmoothOptions {
   std::string dataset;
+  std::string dock;  // --dock: replaces the dataset's dock.yaml
   std::string out;
   std::string config;
   bool quiet = false;
@@ -41,11 +43,11 @@ void Smooth(const SmoothOptions& options) {
   const auto start = Clock::now();
   const RunConfig config = options.config.empty() ? RunConfig{} : LoadRunConfig(options.config);
   std::vector<std::string> skipped_rows;
-  const Dataset dataset = LoadDataset(options.dataset, &skipped_rows);
+  const Dataset dataset = LoadDatasetWithDock(options.dataset, options.dock, &skipped_rows);
   if (!dataset.calibration.imu) throw InputError(options.dataset + ": calibration has no IMU");
   VisionFrameSource source(dataset, ParseDetectorKind(options.detector),
                            SyncToleranceNs(options.sync_tolerance_ms), options.detections);
-  SlidingWindowEstimator estimator(dataset.calibration, *dataset.dock, config.estimator);
+  SlidingWindowEstimator estimator(dataset.calibration, RequireDock(dataset), config.estimator);
   EstimateWriter writer(options.out);
 
   const CancellationToken cancel = InstallSignalCancellation();
@@ -156,6 +158,7 @@ void AddSmoothCommand(CLI::App& root) {
   CLI::App* sub = root.add_subcommand(
       "smooth", "Batch smoothing of a whole log: trajectory, covariance, go/no-go decisions");
   sub->add_option("--dataset", options->dataset, "Dataset folder")->required();
+  AddDockOption(sub, &options->dock);
   sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
   sub->add_option("--config", options->config, "Estimator and go/no-go options (YAML)");
   sub->add_option("--detector", options->detector,

@@ -1,5 +1,7 @@
 #include "apps/vision_frame_source.h"
 
+#include "apps/dataset_input.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -25,12 +27,6 @@ PaperBaselineOptions PipelineOptions(LightDetectorKind detector) {
 
 using Clock = std::chrono::steady_clock;
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
-
-const DockModel& RequireDock(const Dataset& dataset) {
-  if (!dataset.dock)
-    throw InputError(dataset.root + ": no dock.yaml: the dock's lights are needed");
-  return *dataset.dock;
-}
 
 cv::Mat ReadImage(const CameraFrame& frame, const CameraCalibration& camera, int* n_bad) {
   cv::Mat image = cv::imread(frame.path, cv::IMREAD_COLOR);

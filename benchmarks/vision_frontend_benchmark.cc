@@ -3,6 +3,8 @@
 //  * BM_Dehaze, BM_Detect: dark-channel dehazing (seed 000's enhancement) and guide-light
 //    detection on the stereo-left frame 8 s into the run (all six lights at about 5 m);
 //  * BM_DetectBlob: the real-water detector (BlobLightDetector) on the same frame;
+//  * BM_DetectBlobFixedLevels: the same without the clip level and the neck cut (for the ratio);
+//  * BM_ImageLevels: its reading of the image's noise and clip level (image_levels.h);
 //  * BM_PerFrame: the whole per-frame path of the paper's baseline (PaperBaselinePipeline::Process
 //    with dehazing on): dehaze + detect + match (hypothesise-and-verify, MatchRansac) + pose.
 //    Arguments width, height, camera, dehaze (1: on, as the budget counts; 0: the pipeline's
@@ -23,12 +25,14 @@
 
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "auvdock/sim/docking_trajectory.h"
 #include "auvdock/sim/scenario.h"
 #include "auvdock/sim/underwater_renderer.h"
 #include "auvdock/vision/blob_light_detector.h"
 #include "auvdock/vision/dark_channel_dehazer.h"
+#include "auvdock/vision/image_levels.h"
 #include "auvdock/vision/light_detector.h"
 #include "auvdock/vision/paper_baseline_pipeline.h"
 
@@ -98,6 +102,38 @@ void BM_DetectBlob(benchmark::State& state) {
   TimeDetection(BlobLightDetector(options), state);
 }
 BENCHMARK(BM_DetectBlob)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
+
+// BM_DetectBlob without what adapts it to the exposure: no clip level, no neck cut (the detector
+// as it was before them), for the ratio of the two in one run.
+void BM_DetectBlobFixedLevels(benchmark::State& state) {
+  BlobLightDetectorOptions options;
+  options.checks.colour = LightColour::kBlueGreen;
+  options.adapt_to_clip_level = false;
+  options.core.neck_cut_sigmas = 0.0;
+  TimeDetection(BlobLightDetector(options), state);
+}
+BENCHMARK(BM_DetectBlobFixedLevels)
+    ->Args({640, 512})
+    ->Args({1280, 1024})
+    ->Unit(benchmark::kMillisecond);
+
+// The part of BM_DetectBlob that reads the image's own levels (image_levels.h): its noise and
+// clip level, on the same frame's luma.
+void BM_ImageLevels(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const cv::Mat frame =
+      RenderFrame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  cv::Mat gray, luma;
+  cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
+  gray.convertTo(luma, CV_32F);
+  for (auto _ : state) {
+    double noise = EstimatePixelNoise(luma);
+    std::optional<double> clip = EstimateClipLevel(gray, frame);
+    benchmark::DoNotOptimize(noise);
+    benchmark::DoNotOptimize(clip);
+  }
+}
+BENCHMARK(BM_ImageLevels)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
 
 double ThreadCpuSeconds() {
   timespec now{};

@@ -65,9 +65,23 @@ Dataset LoadDataset(const std::string& dir, std::vector<std::string>* skipped_ro
   std::error_code ec;
   if (!fs::is_directory(root, ec)) throw InputError(dir + ": not a dataset folder");
   if (fs::exists(root / "calibration.yaml")) return LoadAuvdockDataset(root, skipped_rows);
-  if (fs::is_directory(root / "mav0")) return internal::LoadEurocDataset((root / "mav0").string(), skipped_rows);
+  // A EuRoC sequence has no dock: a dock.yaml beside its mav0/ (or inside it) is the user's.
+  auto with_dock = [](Dataset ds, const std::vector<fs::path>& places) {
+    for (const fs::path& p : places) {
+      if (fs::exists(p)) {
+        ds.dock = LoadDockModel(p.string());
+        break;
+      }
+    }
+    return ds;
+  };
+  if (fs::is_directory(root / "mav0")) {
+    return with_dock(internal::LoadEurocDataset((root / "mav0").string(), skipped_rows),
+                     {root / "dock.yaml", root / "mav0" / "dock.yaml"});
+  }
   if (fs::exists(root / "imu0" / "sensor.yaml") || fs::exists(root / "cam0" / "sensor.yaml")) {
-    return internal::LoadEurocDataset(root.string(), skipped_rows);
+    return with_dock(internal::LoadEurocDataset(root.string(), skipped_rows),
+                     {root / "dock.yaml", root.parent_path() / "dock.yaml"});
   }
   throw InputError(dir + ": not a dataset folder (no calibration.yaml, and no EuRoC mav0/)");
 }

@@ -37,13 +37,14 @@ std::vector<LightDetection> BlobLightDetector::Detect(const cv::Mat& image,
     throw std::invalid_argument("BlobLightDetector: expected a non-empty CV_8UC3 or CV_8UC1 image");
   }
   const cv::Mat source = options_.deinterlace ? LineDoubleEvenField(image) : image;
-  cv::Mat luma;
+  cv::Mat gray;
   if (source.channels() == 3) {
-    cv::cvtColor(source, luma, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(source, gray, cv::COLOR_BGR2GRAY);
   } else {
-    luma = source;
+    gray = source;
   }
-  luma.convertTo(luma, CV_32F);
+  cv::Mat luma;
+  gray.convertTo(luma, CV_32F);
   const double noise = EstimatePixelNoise(luma);
   const bool has_colour = source.channels() == 3;
   const double background_excess = MedianColourExcess(source, options_.checks.colour);
@@ -60,7 +61,9 @@ std::vector<LightDetection> BlobLightDetector::Detect(const cv::Mat& image,
   // and its contrasts are those of a full-range image scaled by clip / 255.
   BlobCandidateOptions candidate_options = options_.candidates;
   double score_response = options_.score_response;
-  if (const std::optional<double> clip = EstimateClipLevel(luma, source)) {
+  const std::optional<double> clip =
+      options_.adapt_to_clip_level ? EstimateClipLevel(gray, source) : std::nullopt;
+  if (clip) {
     checks.saturation_level =
         std::min(checks.saturation_level, *clip - (255.0 - options_.checks.saturation_level));
     candidate_options.min_response *= std::min(1.0, *clip / 255.0);

@@ -27,10 +27,11 @@ double MedianChannelSpread(const cv::Mat& bgr, const cv::Mat& luma, int level) {
   if (bgr.empty() || bgr.type() != CV_8UC3) return 0.0;
   std::vector<int> spreads;
   for (int y = 0; y < luma.rows; ++y) {
-    const float* row = luma.ptr<float>(y);
     const cv::Vec3b* colour = bgr.ptr<cv::Vec3b>(y);
     for (int x = 0; x < luma.cols; ++x) {
-      if (std::abs(row[x] - level) > 1.5f) continue;
+      const float value =
+          luma.type() == CV_8UC1 ? luma.ptr<uchar>(y)[x] : luma.ptr<float>(y)[x];
+      if (std::abs(value - level) > 1.5f) continue;
       const cv::Vec3b& p = colour[x];
       spreads.push_back(std::max({p[0], p[1], p[2]}) - std::min({p[0], p[1], p[2]}));
     }
@@ -45,10 +46,17 @@ double MedianChannelSpread(const cv::Mat& bgr, const cv::Mat& luma, int level) {
 std::optional<double> EstimateClipLevel(const cv::Mat& luma, const cv::Mat& bgr,
                                         const ClipLevelOptions& options) {
   std::array<long, 256> h{};
-  for (int y = 0; y < luma.rows; ++y) {
-    const float* row = luma.ptr<float>(y);
-    for (int x = 0; x < luma.cols; ++x) {
-      ++h[static_cast<size_t>(std::clamp(static_cast<int>(std::lround(row[x])), 0, 255))];
+  if (luma.type() == CV_8UC1) {
+    for (int y = 0; y < luma.rows; ++y) {
+      const uchar* row = luma.ptr<uchar>(y);
+      for (int x = 0; x < luma.cols; ++x) ++h[row[x]];
+    }
+  } else {
+    for (int y = 0; y < luma.rows; ++y) {
+      const float* row = luma.ptr<float>(y);
+      for (int x = 0; x < luma.cols; ++x) {
+        ++h[static_cast<size_t>(std::clamp(static_cast<int>(row[x] + 0.5f), 0, 255))];
+      }
     }
   }
   std::array<long, 257> at_or_above{};  // at_or_above[k]: pixels at level k or brighter

@@ -5,6 +5,7 @@
 // row it wrote before the stop.
 #include <signal.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -87,6 +88,36 @@ TEST_F(DetectionsReplayCli, ADatasetWithoutImagesPointsToTheDetections) {
   const auto r = test::RunAuvdock({"run", "--dataset", dataset_, "--out", *tmp_ / "no_images"});
   EXPECT_EQ(r.exit_status, 2);
   EXPECT_THAT(r.err, HasSubstr("--detections"));
+}
+
+// A dataset folder without its dock.yaml (a real log, a EuRoC sequence): the run says how to give
+// one; --dock gives it from anywhere, and a malformed one is named.
+TEST_F(DetectionsReplayCli, TheDockComesFromDockWhenTheDatasetHasNone) {
+  const fs::path bare = *tmp_ / "bare";
+  fs::copy(dataset_, bare, fs::copy_options::recursive);
+  fs::remove(bare / "dock.yaml");
+  const std::vector<std::string> run = {"run", "--dataset", bare.string(), "--detections",
+                                        dataset_ + "/detections.csv", "--quiet"};
+  auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = run;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return test::RunAuvdock(args);
+  };
+  const auto without = with({"--out", *tmp_ / "bare_out"});
+  EXPECT_EQ(without.exit_status, 2);
+  EXPECT_THAT(without.err, HasSubstr("--dock"));
+  EXPECT_EQ(std::count(without.err.begin(), without.err.end(), '\n'), 1) << without.err;
+
+  const auto given =
+      with({"--dock", dataset_ + "/dock.yaml", "--out", *tmp_ / "bare_docked"});
+  ASSERT_EQ(given.exit_status, 0) << given.err;
+  EXPECT_GE(ReadTumTrajectory(*tmp_ / "bare_docked/trajectory.tum").size(), 110u);
+
+  const std::string bad = *tmp_ / "bad_dock.yaml";
+  test::WriteTextFile(bad, "lights: [[0, 0\n");
+  const auto malformed = with({"--dock", bad, "--out", *tmp_ / "bare_bad"});
+  EXPECT_EQ(malformed.exit_status, 2);
+  EXPECT_THAT(malformed.err, HasSubstr("bad_dock.yaml"));
 }
 
 int CountLines(const std::string& path) {

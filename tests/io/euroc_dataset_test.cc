@@ -1,8 +1,12 @@
 // A real EuRoC/ASL sequence layout (mav0/...) loads: sensor.yaml calibrations, IMU, cameras and
 // the state ground truth. The fixture holds EuRoC MH_01's calibration files and a few rows.
+#include <filesystem>
+
 #include <gtest/gtest.h>
 
 #include "auvdock/io/dataset.h"
+#include "auvdock/io/input_error.h"
+#include "tests/testing/temp_dir.h"
 #include "tests/testing/test_scenarios.h"
 
 namespace auvdock {
@@ -38,6 +42,28 @@ TEST(EurocDataset, LoadsSequenceFolderAndMavFolder) {
     EXPECT_DOUBLE_EQ(ds.groundtruth[0].accel_bias.z(), 0.075593);
     EXPECT_FALSE(ds.dock.has_value());
     EXPECT_TRUE(ds.visibility.empty());
+  }
+}
+
+// A EuRoC sequence has no dock; the user's dock.yaml beside mav0/ is read, whichever of the two
+// folders is given, and a malformed one names itself.
+TEST(EurocDataset, ADockFileBesideTheSequenceIsItsDock) {
+  namespace fs = std::filesystem;
+  test::TempDir tmp;
+  const fs::path sequence = fs::path(tmp.path()) / "MH_01";
+  fs::copy(test::SourcePath("tests/data/euroc_mini"), sequence, fs::copy_options::recursive);
+  fs::copy_file(test::SourcePath("data/docks/t_shape.yaml"), sequence / "dock.yaml");
+  for (const fs::path& dir : {sequence, sequence / "mav0"}) {
+    const Dataset ds = LoadDataset(dir.string());
+    ASSERT_TRUE(ds.dock.has_value()) << dir;
+    EXPECT_GE(ds.dock->lights.size(), 4u);
+  }
+  test::WriteTextFile((sequence / "dock.yaml").string(), "lights: [1, 2\n");
+  try {
+    LoadDataset(sequence.string());
+    FAIL() << "a malformed dock.yaml loaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("dock.yaml"), std::string::npos) << e.what();
   }
 }
 

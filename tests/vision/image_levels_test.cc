@@ -101,7 +101,9 @@ TEST(EstimateClipLevel, AFlatColouredSurfaceIsNoClip) {
     luma.convertTo(luma, CV_32F);
     const auto level = EstimateClipLevel(luma, bgr);
     EXPECT_EQ(level.has_value(), white);
-    if (white && level) EXPECT_NEAR(*level, 163.0, 1.0);
+    if (white && level) {
+      EXPECT_NEAR(*level, 163.0, 1.0);
+    }
     EXPECT_TRUE(EstimateClipLevel(luma).has_value()) << "without colour, a pile-up is a clip";
   }
 }

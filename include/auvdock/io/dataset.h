@@ -21,7 +21,8 @@ struct Dataset {
   std::string root;  // the folder the sensor folders live in (".../mav0" for EuRoC)
   DatasetLayout layout = DatasetLayout::kAuvdock;
   Calibration calibration;
-  std::optional<DockModel> dock;  // absent in EuRoC sequences
+  // dock.yaml; in a EuRoC sequence, a dock.yaml beside mav0/ or inside it, else absent.
+  std::optional<DockModel> dock;
   std::vector<ImuSample> imu;
   std::vector<DepthMeasurement> depth;
   std::vector<DvlMeasurement> dvl;

@@ -46,6 +46,9 @@ namespace auvdock {
 
 struct BlobLightDetectorOptions {
   bool deinterlace = false;  // keep the even field, rebuild odd rows (combing)
+  // Read the image's clip level (image_levels.h) and judge saturation and contrast by it; off: a
+  // full-range camera is assumed (saturation at checks.saturation_level, contrasts as they are).
+  bool adapt_to_clip_level = true;
   // Scale-normalised LoG response of at least 30 gray levels: a light of ~60 levels of contrast
   // at its own scale (lower thresholds let the pool footage's clutter through: at 10, precision
   // 0.12 on the pool clip). Scales 1.44 apart from 1.5 px (the optics' blur) to 120 px; maxima

@@ -42,7 +42,7 @@ struct ClipLevelOptions {
   double max_channel_spread = 0.1;
 };
 
-// luma: CV_32FC1 (values in [0, 255]); bgr: the CV_8UC3 image it comes from (empty or CV_8UC1:
+// luma: CV_8UC1, or CV_32FC1 with values in [0, 255]; bgr: the CV_8UC3 image it comes from (empty or CV_8UC1:
 // no colour test). nullopt when the image shows no clipping.
 std::optional<double> EstimateClipLevel(const cv::Mat& luma, const cv::Mat& bgr = cv::Mat(),
                                         const ClipLevelOptions& options = {});
