@@ -39,6 +39,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "apps/commands.h"
+#include "apps/help_text.h"
 #include "apps/reason_class.h"
 #include "apps/signal_flag.h"
 #include "auvdock/eval/detection_evaluation.h"
@@ -352,6 +353,7 @@ void AddDetectCommand(CLI::App& root) {
       "detect",
       "Detect and identify the dock's lights in one's own images (mono pose per image); writes "
       "detections.csv, frames.csv, camera_poses.tum, summary.json [, overlay/]");
+  sub->footer(DetectHelp());
   sub->add_option("--images", options->images, "Image files, a glob pattern: \"DIR/*.jpg\"")
       ->required();
   sub->add_option("--calib", options->calib,
@@ -367,7 +369,8 @@ void AddDetectCommand(CLI::App& root) {
                   "a simulated dataset's groundtruth/<camera>_lights.csv)")
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--colour", options->colour,
-                  "Light colour (white, blue, green, blue_green, red); default: the dock's");
+                  "Light colour (white, blue, green, blue_green, red); default: the dock's")
+      ->check(CLI::IsMember({"white", "blue", "green", "blue_green", "red"}));
   sub->add_flag("--overlay", options->overlay, "Write each image with the detections drawn");
   sub->add_flag("--deinterlace", options->deinterlace,
                 "Interlaced video: detect on the even field, line-doubled");

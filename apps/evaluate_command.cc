@@ -14,7 +14,9 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "apps/cli_validators.h"
 #include "apps/commands.h"
+#include "apps/help_text.h"
 #include "apps/plot_script.h"
 #include "auvdock/estimator/go_no_go.h"
 #include "auvdock/eval/trajectory_evaluation.h"
@@ -42,20 +44,6 @@ struct EvaluateOptions {
   double max_truth_gap_s = 0.1;
   std::string plots_dir;  // optional: PNG plots (plot_script.h)
 };
-
-// CLI11's PositiveNumber prints its range up to DBL_MAX in full; this says what is meant.
-CLI::Validator Positive(const std::string& unit) {
-  return CLI::Validator(
-      [unit](std::string& text) {
-        char* end = nullptr;
-        const double value = std::strtod(text.c_str(), &end);
-        if (text.empty() || *end != '\0' || !std::isfinite(value) || !(value > 0.0)) {
-          return "must be a positive number of " + unit + " (got '" + text + "')";
-        }
-        return std::string();
-      },
-      "POSITIVE");
-}
 
 nlohmann::ordered_json Vector3Json(const Eigen::Vector3d& v) {
   return nlohmann::ordered_json::array({v.x(), v.y(), v.z()});
@@ -253,6 +241,7 @@ void AddEvaluateCommand(CLI::App& root) {
   auto options = std::make_shared<EvaluateOptions>();
   CLI::App* sub = root.add_subcommand(
       "evaluate", "Compare an estimated trajectory (TUM file) with a dataset's ground truth");
+  sub->footer(EvaluateHelp());
   sub->add_option("--dataset", options->dataset_dir, "Dataset folder with ground truth")
       ->required()
       ->check(CLI::ExistingDirectory);

@@ -23,6 +23,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "apps/commands.h"
+#include "apps/help_text.h"
 #include "apps/dataset_input.h"
 #include "apps/reason_class.h"
 #include "apps/signal_flag.h"
@@ -189,16 +190,19 @@ void AddFrontendCommand(CLI::App& root) {
   auto options = std::make_shared<FrontendOptions>();
   CLI::App* sub = root.add_subcommand(
       "frontend", "Per-frame vision (the paper's pipeline): detections, stages, per-frame poses");
+  sub->footer(FrontendHelp());
   sub->add_option("--dataset", options->dataset, "Dataset folder")->required();
   AddDockOption(sub, &options->dock);
   sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
   sub->add_flag("--dehaze", options->dehaze, "Dark-channel dehazing before detection");
   sub->add_flag("--no-tracking", options->no_tracking,
                 "Identify every frame from scratch (the paper's frame-independent matching)");
-  sub->add_option("--matcher", options->matcher, "ransac (default) or omnidirectional");
+  sub->add_option("--matcher", options->matcher, "ransac (default) or omnidirectional")
+      ->check(CLI::IsMember({"ransac", "omnidirectional"}));
   sub->add_option("--detector", options->detector,
                   "contrast (default: developed on our renders) or blob (real water: "
-                  "blob_light_detector.h, the dock's colour)");
+                  "blob_light_detector.h, the dock's colour)")
+      ->check(CLI::IsMember({"contrast", "blob"}));
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { RunFrontend(*options); });
 }

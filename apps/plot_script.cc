@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/data_files.h"
 #include "auvdock/io/input_error.h"
 
 namespace auvdock::cli {
@@ -17,12 +18,6 @@ namespace {
 
 constexpr const char* kPython = "/usr/bin/python3";
 constexpr const char* kScriptName = "plot_run.py";
-
-std::filesystem::path ExecutableDir() {
-  std::error_code error;
-  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
-  return error ? std::filesystem::path() : self.parent_path();
-}
 
 std::string LastLine(const std::string& text) {
   std::string trimmed = text;

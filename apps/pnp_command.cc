@@ -11,7 +11,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "apps/cli_validators.h"
 #include "apps/commands.h"
+#include "apps/help_text.h"
 #include "auvdock/geometry/so3.h"
 #include "auvdock/io/camera_file.h"
 #include "auvdock/io/csv.h"
@@ -79,6 +81,7 @@ void AddPnpCommand(CLI::App& root) {
   auto options = std::make_shared<PnpCommandOptions>();
   CLI::App* sub = root.add_subcommand(
       "pnp", "Solve a camera pose from 3-D/2-D correspondences (x_cam = R X + t), as JSON");
+  sub->footer(PnpHelp());
   sub->add_option("--calib", options->calib,
                   "calibration.yaml of a dataset, or an OpenCV FileStorage calibration")
       ->required();
@@ -86,7 +89,8 @@ void AddPnpCommand(CLI::App& root) {
                   "Camera name in calibration.yaml (not needed for an OpenCV file)");
   sub->add_option("--points", options->points, "CSV with header X,Y,Z,u,v")->required();
   sub->add_option("--pixel-sigma", options->pixel_sigma,
-                  "1-sigma pixel noise for the covariance (default: the calibration's)");
+                  "1-sigma pixel noise for the covariance (default: the calibration's)")
+      ->check(Positive("pixels"));
   sub->callback([options] { RunPnp(*options); });
 }
 

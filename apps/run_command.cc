@@ -11,7 +11,9 @@
 #include <cstdio>
 #include <memory>
 
+#include "apps/cli_validators.h"
 #include "apps/commands.h"
+#include "apps/help_text.h"
 #include "apps/dataset_input.h"
 #include "apps/estimate_writer.h"
 #include "apps/run_summary.h"
@@ -122,15 +124,18 @@ void AddRunCommand(CLI::App& root) {
   auto options = std::make_shared<RunOptions>();
   CLI::App* sub = root.add_subcommand(
       "run", "Causal sliding-window estimation: trajectory, covariance, go/no-go decisions");
+  sub->footer(RunHelp());
   sub->add_option("--dataset", options->dataset, "Dataset folder")->required();
   AddDockOption(sub, &options->dock);
   sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
   sub->add_option("--config", options->config, "Estimator and go/no-go options (YAML)");
   sub->add_option("--detector", options->detector,
-                  "contrast (default: developed on our renders) or blob (real water)");
+                  "contrast (default: developed on our renders) or blob (real water)")
+      ->check(CLI::IsMember({"contrast", "blob"}));
   sub->add_option("--sync-tolerance-ms", options->sync_tolerance_ms,
                   "Images of different cameras this close in time share one state (default: half "
-                  "the shortest frame interval; 0: equal time stamps only)");
+                  "the shortest frame interval; 0: equal time stamps only)")
+      ->check(NonNegative("milliseconds"));
   sub->add_option("--detections", options->detections,
                   "Replay these light detections (detections.csv: `simulate` with render_images "
                   "false, `frontend`, or a detector of your own) instead of the images");

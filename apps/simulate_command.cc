@@ -6,7 +6,9 @@
 #include <memory>
 #include <optional>
 
+#include "apps/cli_validators.h"
 #include "apps/commands.h"
+#include "apps/help_text.h"
 #include "apps/signal_flag.h"
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/measurements.h"
@@ -78,6 +80,7 @@ void AddSimulateCommand(CLI::App& root) {
   auto options = std::make_shared<SimulateOptions>();
   CLI::App* sub = root.add_subcommand(
       "simulate", "Simulate a docking run and write a dataset folder with ground truth");
+  sub->footer(SimulateHelp());
   sub->add_option("--scenario", options->scenario, "Scenario YAML (e.g. data/scenarios/default.yaml)")
       ->required();
   sub->add_option("--out", options->out, "Output dataset folder (must not exist or be empty)")
@@ -88,7 +91,8 @@ void AddSimulateCommand(CLI::App& root) {
                 "cameras.synthetic_detections), for run/smooth --detections");
   sub->add_option("--fault-scale", options->fault_scale,
                   "Multiply the scenario's fault rates (DVL spikes and biases, acoustic outliers, "
-                  "synthetic misses, spurious blobs and wrong ids) by this factor");
+                  "synthetic misses, spurious blobs and wrong ids) by this factor")
+      ->check(NonNegative("times the scenario's rates"));
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { RunSimulate(*options); });
 }

@@ -40,8 +40,8 @@ class CliTest : public ::testing::Test {
   static void SetUpTestSuite() {
     tmp_ = new test::TempDir();
     dataset_ = *tmp_ / "ds";
-    const auto r = test::RunAuvdock({"simulate", "--scenario", WriteShortScenario(*tmp_, 3.0),
-                                     "--out", dataset_, "--quiet"});
+    const auto r = test::RunAuvdock(
+        {"simulate", "--scenario", WriteShortScenario(*tmp_, 3.0), "--out", dataset_, "--quiet"});
     ASSERT_EQ(r.exit_status, 0) << r.err;
   }
   static void TearDownTestSuite() { delete tmp_; }
@@ -82,7 +82,8 @@ TEST_F(CliTest, EvaluateReturnsAKnownOffset) {
   for (auto& pose : estimate) pose.T_D_B.p += offset;
   const std::string path = *tmp_ / "shifted.tum";
   WriteTumTrajectory(path, estimate);
-  const auto r = test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate", path, "--json"});
+  const auto r =
+      test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate", path, "--json"});
   ASSERT_EQ(r.exit_status, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_NEAR(j.at("pos_rmse_m").get<double>(), offset.norm(), 1e-9);
@@ -117,12 +118,12 @@ TEST_F(CliTest, EvaluateWritesThePlots) {
   test::WriteTextFile(covariance_path, covariance);
   const std::string plots = *tmp_ / "plots";
   const auto r = test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate",
-                                   dataset_ + "/groundtruth.tum", "--covariance",
-                                   covariance_path, "--plots", plots});
+                                   dataset_ + "/groundtruth.tum", "--covariance", covariance_path,
+                                   "--plots", plots});
   ASSERT_EQ(r.exit_status, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("plots: " + plots));
-  for (const char* name : {"trajectory.png", "errors.png", "stages.png", "nees.png",
-                           "go_no_go.png"}) {
+  for (const char* name :
+       {"trajectory.png", "errors.png", "stages.png", "nees.png", "go_no_go.png"}) {
     std::ifstream png(plots + "/" + name, std::ios::binary);
     char signature[4] = {};
     png.read(signature, 4);
@@ -171,6 +172,50 @@ TEST(Cli, UnknownWordsNameThemselvesAndTheClosestValidOne) {
   EXPECT_THAT(far.err, AllOf(HasSubstr("'--xyzzy'"), HasSubstr("simulate --help")));
   // Known words pass to the parser: its own message for what is missing.
   EXPECT_THAT(test::RunAuvdock({"run"}).err, HasSubstr("--dataset"));
+}
+
+// Each subcommand's help says what it needs, what it writes and how to call it; where it
+// mentions the shipped scenarios or options, their folder as this binary finds it (the build
+// tree's share/auvdock links to data/), which exists.
+TEST(Cli, EachSubcommandsHelpSaysWhatItNeedsAndWrites) {
+  for (const char* sub : {"simulate", "run", "smooth", "frontend", "evaluate", "pnp", "detect"}) {
+    const auto r = test::RunAuvdock({sub, "--help"});
+    EXPECT_EQ(r.exit_status, 0) << sub;
+    EXPECT_THAT(r.out,
+                AllOf(HasSubstr("Needs:"), HasSubstr("Example: auvdock " + std::string(sub))))
+        << sub;
+  }
+  const auto run = test::RunAuvdock({"run", "--help"});
+  EXPECT_THAT(run.out, AllOf(HasSubstr("--dock"), HasSubstr("trajectory.tum"),
+                             HasSubstr("covariance.csv"), HasSubstr("decisions.csv")));
+  const auto simulate = test::RunAuvdock({"simulate", "--help"});
+  const std::string marker = "Shipped scenarios: ";
+  const size_t at = simulate.out.find(marker);
+  ASSERT_NE(at, std::string::npos) << simulate.out;
+  const std::string folder = simulate.out.substr(
+      at + marker.size(), simulate.out.find(' ', at + marker.size()) - at - marker.size());
+  EXPECT_TRUE(fs::exists(fs::path(folder) / "default.yaml")) << folder;
+  EXPECT_THAT(simulate.out, HasSubstr("randomized.yaml"));
+}
+
+// Values are checked by the parser: one line naming the option and what it takes, exit 2.
+TEST(Cli, OptionValuesAreCheckedByTheParser) {
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"frontend", "--dataset", "x", "--out", "y", "--matcher", "nearest"}, "--matcher"},
+      {{"run", "--dataset", "x", "--out", "y", "--detector", "sift"}, "--detector"},
+      {{"pnp", "--calib", "x", "--points", "y", "--pixel-sigma", "-1"},
+       "positive number of pixels"},
+      {{"run", "--dataset", "x", "--out", "y", "--sync-tolerance-ms", "-2"}, "non-negative"},
+      {{"detect", "--images", "x", "--calib", "y", "--dock", "z", "--out", "w", "--colour", "pink"},
+       "--colour"},
+  };
+  for (const auto& [args, expected] : cases) {
+    const auto r = test::RunAuvdock(args);
+    EXPECT_EQ(r.exit_status, 2) << args[0];
+    EXPECT_EQ(CountLines(r.err), 1) << r.err;
+    EXPECT_THAT(r.err, HasSubstr(expected));
+    EXPECT_THAT(r.err, Not(HasSubstr("not a dataset folder"))) << "checked before any work";
+  }
 }
 
 TEST(Cli, UsageErrorsExitTwo) {
