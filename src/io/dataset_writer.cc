@@ -59,14 +59,14 @@ void DatasetWriter::AddFault(const FaultRecord& f) { faults_->Line(FaultCsvRow(f
 
 void DatasetWriter::AddDetections(const ImageDetections& image) {
   if (!detections_) {
-    detections_ = std::make_unique<DetectionsCsvWriter>((fs::path(root_) / "detections.csv").string());
+    detections_ =
+        std::make_unique<DetectionsCsvWriter>((fs::path(root_) / "detections.csv").string());
   }
   detections_->Append(image.t_ns, image.camera, image.detections, image.light_ids);
 }
 
 void DatasetWriter::AddLightTruth(const std::string& camera, int64_t t_ns,
-                                      const std::vector<LightTruth>& lights, int width,
-                                      int height) {
+                                  const std::vector<LightTruth>& lights, int width, int height) {
   std::unique_ptr<CsvWriter>& out = rendered_lights_[camera];
   if (!out) {
     out = std::make_unique<CsvWriter>(
@@ -83,8 +83,8 @@ void DatasetWriter::AddLightTruth(const std::string& camera, int64_t t_ns,
     const bool inside = light.uv.x() >= margin - 0.5 && light.uv.y() >= margin - 0.5 &&
                         light.uv.x() <= width - 0.5 - margin &&
                         light.uv.y() <= height - 0.5 - margin;
-    out->Line(file + "," + std::to_string(light.light_id) + "," + FormatDouble(light.uv.x()) +
-              "," + FormatDouble(light.uv.y()) + "," + (inside ? "ok" : "border") + "," +
+    out->Line(file + "," + std::to_string(light.light_id) + "," + FormatDouble(light.uv.x()) + "," +
+              FormatDouble(light.uv.y()) + "," + (inside ? "ok" : "border") + "," +
               FormatDouble(light.range_m) + "," + FormatDouble(light.sigma_px) + "," +
               FormatDouble(light.peak));
   }
@@ -96,8 +96,21 @@ void DatasetWriter::AddGroundTruth(const GroundTruthState& s) {
 }
 
 void DatasetWriter::AddImage(const std::string& camera, int64_t t_ns, const cv::Mat& image) {
+  WriteImageFile(camera, t_ns, image);
+  AddImageRow(camera, t_ns);
+}
+
+void DatasetWriter::AddImageRow(const std::string& camera, int64_t t_ns) {
   auto it = cameras_.find(camera);
   if (it == cameras_.end()) throw InputError("no camera named '" + camera + "' in calibration");
+  it->second->Line(std::to_string(t_ns) + "," + std::to_string(t_ns) + ".png");
+}
+
+void DatasetWriter::WriteImageFile(const std::string& camera, int64_t t_ns,
+                                   const cv::Mat& image) const {
+  if (cameras_.find(camera) == cameras_.end()) {
+    throw InputError("no camera named '" + camera + "' in calibration");
+  }
   const std::string file = std::to_string(t_ns) + ".png";
   const fs::path path = fs::path(root_) / camera / "data" / file;
   // Huffman-only deflate: sensor noise leaves little for LZ77 to find, so this is both the
@@ -108,7 +121,6 @@ void DatasetWriter::AddImage(const std::string& camera, int64_t t_ns, const cv::
                     cv::IMWRITE_PNG_STRATEGY_HUFFMAN_ONLY})) {
     throw InputError(path.string() + ": cannot write image");
   }
-  it->second->Line(std::to_string(t_ns) + "," + file);
 }
 
 void DatasetWriter::Close() {

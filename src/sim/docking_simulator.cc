@@ -1,6 +1,7 @@
 #include "auvdock/sim/docking_simulator.h"
 
 #include <cmath>
+#include <future>
 #include <limits>
 #include <optional>
 
@@ -16,14 +17,15 @@
 namespace auvdock {
 
 DockingSimulator::DockingSimulator(const Scenario& scenario)
-    : scenario_(scenario), calibration_(MakeCalibration(scenario)),
+    : scenario_(scenario),
+      calibration_(MakeCalibration(scenario)),
       trajectory_(scenario.trajectory) {
   const WaterModel water = WaterModel::ForType(scenario.water_type);
   RenderOptions render = scenario.render;
   if (!scenario.noise_enabled) render.noise_sigma = 0.0;  // a noise-free run has clean images
   for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
-    std::mt19937_64 look_rng = MakeRandomStream(
-        scenario.seed, static_cast<uint64_t>(RandomStreamId::kRenderLookBase) + i);
+    std::mt19937_64 look_rng =
+        MakeRandomStream(scenario.seed, static_cast<uint64_t>(RandomStreamId::kRenderLookBase) + i);
     renderers_.emplace_back(calibration_.cameras[i], scenario.dock, water, render,
                             DrawRenderLook(scenario.randomize, scenario.dock, look_rng));
   }
@@ -64,9 +66,9 @@ int64_t SampleCount(double duration_s, double rate_hz) {
 }
 
 std::string DistractorDetail(const RenderedDistractor& d) {
-  return "u=" + FormatDouble(std::round(d.uv.x() * 100) / 100) + ";v=" +
-         FormatDouble(std::round(d.uv.y() * 100) / 100) + ";sigma_px=" +
-         FormatDouble(std::round(d.radius_px * 100) / 100);
+  return "u=" + FormatDouble(std::round(d.uv.x() * 100) / 100) +
+         ";v=" + FormatDouble(std::round(d.uv.y() * 100) / 100) +
+         ";sigma_px=" + FormatDouble(std::round(d.radius_px * 100) / 100);
 }
 
 }  // namespace
@@ -130,7 +132,8 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
     for (; k_dvl < n_dvl && SampleTime(k_dvl, s.dvl.rate_hz) <= t_end_ns; ++k_dvl) {
       const int64_t t = SampleTime(k_dvl, s.dvl.rate_hz);
       std::optional<FaultRecord> fault;
-      const std::optional<DvlMeasurement> sample = dvl.Sample(t, trajectory_.At(Seconds(t)), &fault);
+      const std::optional<DvlMeasurement> sample =
+          dvl.Sample(t, trajectory_.At(Seconds(t)), &fault);
       record_fault(fault);
       if (!sample) continue;  // no bottom lock: no sample
       writer.AddDvl(*sample);
@@ -155,15 +158,40 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
     const VisibilityRecord visibility = VisibilityAt(t);
     writer.AddVisibility(visibility);
     summary.stage_duration_s[static_cast<int>(visibility.stage)] += frame_period_s;
-    for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
+    const size_t n_cameras = calibration_.cameras.size();
+    std::vector<int64_t> t_cams(n_cameras);
+    std::vector<Pose3> T_D_Cs(n_cameras);
+    for (std::size_t i = 0; i < n_cameras; ++i) {
       const auto& cam = calibration_.cameras[i];
       // Each camera at its own exposure time (the mono camera may lag the stereo pair).
-      const int64_t t_cam = cam.role == CameraRole::kMono ? t + mono_offset_ns : t;
-      const Pose3 T_D_C = trajectory_.At(Seconds(t_cam)).T_D_B * cam.T_B_C;
+      t_cams[i] = cam.role == CameraRole::kMono ? t + mono_offset_ns : t;
+      T_D_Cs[i] = trajectory_.At(Seconds(t_cams[i])).T_D_B * cam.T_B_C;
+    }
+    // The cameras' images at once (each from its own renderer and random stream, written to its
+    // own file: the output does not depend on the order), then their rows in calibration order.
+    std::vector<RenderResult> images(n_cameras);
+    if (s.cameras.render_images) {
+      std::vector<std::future<void>> work;
+      for (std::size_t i = 1; i < n_cameras; ++i) {
+        work.push_back(std::async(std::launch::async, [&, i] {
+          images[i] = renderers_[i].Render(T_D_Cs[i], camera_rngs[i]);
+          writer.WriteImageFile(calibration_.cameras[i].name, t_cams[i], images[i].image);
+        }));
+      }
+      if (n_cameras > 0) {
+        images[0] = renderers_[0].Render(T_D_Cs[0], camera_rngs[0]);
+        writer.WriteImageFile(calibration_.cameras[0].name, t_cams[0], images[0].image);
+      }
+      for (auto& w : work) w.get();  // rethrows a camera's failure
+    }
+    for (std::size_t i = 0; i < n_cameras; ++i) {
+      const auto& cam = calibration_.cameras[i];
+      const int64_t t_cam = t_cams[i];
+      const Pose3& T_D_C = T_D_Cs[i];
       std::vector<RenderedLight> lights;
       if (s.cameras.render_images) {
-        const RenderResult image = renderers_[i].Render(T_D_C, camera_rngs[i]);
-        writer.AddImage(cam.name, t_cam, image.image);
+        const RenderResult& image = images[i];
+        writer.AddImageRow(cam.name, t_cam);
         lights = image.lights;
         for (const auto& d : image.distractors) {
           record_fault(FaultRecord{t_cam, cam.name, d.kind, DistractorDetail(d)});

@@ -31,6 +31,10 @@ class DatasetWriter {
   void AddAcoustic(const AcousticFix& m);
   // Writes <camera>/data/<t_ns>.png (lossless, 8-bit) and its data.csv row.
   void AddImage(const std::string& camera, int64_t t_ns, const cv::Mat& image);
+  // The two halves of AddImage: WriteImageFile is const and may run on several threads at once
+  // (for different images); AddImageRow appends the data.csv row, in time order.
+  void WriteImageFile(const std::string& camera, int64_t t_ns, const cv::Mat& image) const;
+  void AddImageRow(const std::string& camera, int64_t t_ns);
   // Appends the lights drawn in one rendered image to groundtruth/<camera>_lights.csv, in the
   // hand-label format (io/light_labels_csv.h) that `auvdock detect --labels` reads: status `ok`
   // when the blob lies 3 sigma + 1 px inside the image, `border` otherwise; a frame without a

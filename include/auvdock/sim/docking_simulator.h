@@ -4,7 +4,9 @@
 // Time base: sample k of a sensor at rate f is at start_time_ns + round(k 1e9 / f), for every
 // k with k / f <= duration_s. Ground truth is written at the IMU rate. Each sensor draws from
 // its own random stream (seed, sensor), so the same scenario and seed give byte-identical
-// output. Work is streamed in time order (one camera frame at a time), memory stays flat.
+// output. Work is streamed in time order (one camera frame at a time), memory stays flat; the
+// cameras of a frame are rendered and their PNGs written on a thread each (the same bytes: each
+// camera has its own renderer, random stream and files).
 #pragma once
 
 #include <array>
