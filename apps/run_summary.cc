@@ -56,6 +56,7 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
   summary["covariance_failures"] = stats.covariance_failures;
   summary["data_duration_s"] = data_duration_s;
   summary["timing_s"] = {{"decode", source.decode_s()},
+                         {"decode_waited", source.decode_wait_s()},
                          {"frontend", source.frontend_s()},
                          {"backend", counters.backend_s},
                          {"total", counters.total_s}};

@@ -1,6 +1,7 @@
 // summary.json of `auvdock run` / `auvdock smooth`: counts of frames, estimates, GO decisions,
 // skipped measurements (with the log of what was skipped and every reset), and the time spent:
-// data_duration_s and timing_s {decode, frontend, backend, total}, plus the speed as a multiple
+// data_duration_s and timing_s {decode (the work, on the decoding thread), decode_waited (the
+// part of it the run waited for), frontend, backend, total (wall)}, plus the speed as a multiple
 // of real time with and without decoding and for the back-end alone. In replay
 // (--detections), given_identities {used, dropped, refused: {reason: images}}.
 #pragma once

@@ -28,7 +28,10 @@ PaperBaselineOptions PipelineOptions(LightDetectorKind detector) {
 using Clock = std::chrono::steady_clock;
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
-cv::Mat ReadImage(const CameraFrame& frame, const CameraCalibration& camera, int* n_bad) {
+// The image of a camera frame; an empty one, and the problem ("PATH: why") appended to
+// `problems`, when it cannot be decoded or has another size than calibrated.
+cv::Mat ReadImage(const CameraFrame& frame, const CameraCalibration& camera,
+                  std::vector<std::string>* problems) {
   cv::Mat image = cv::imread(frame.path, cv::IMREAD_COLOR);
   std::string problem;
   if (image.empty()) {
@@ -39,9 +42,7 @@ cv::Mat ReadImage(const CameraFrame& frame, const CameraCalibration& camera, int
               std::to_string(camera.intrinsics.height());
   }
   if (!problem.empty()) {
-    std::fprintf(stderr, "auvdock: warning: %s: %s; image skipped\n", frame.path.c_str(),
-                 problem.c_str());
-    ++*n_bad;
+    problems->push_back(frame.path + ": " + problem);
     return cv::Mat();
   }
   return image;
@@ -110,8 +111,7 @@ int64_t SyncToleranceNs(double milliseconds) {
 }
 
 VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind detector,
-                                     int64_t sync_tolerance_ns,
-                                     const std::string& detections_path)
+                                     int64_t sync_tolerance_ns, const std::string& detections_path)
     : pipeline_(dataset.calibration, RequireDock(dataset), PipelineOptions(detector)) {
   cameras_ = {pipeline_.left_camera(), pipeline_.right_camera(), pipeline_.mono_camera()};
   if (dataset.calibration.acoustic) {
@@ -179,16 +179,33 @@ VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind d
   for (const std::string& w : pipeline_.warnings()) {
     std::fprintf(stderr, "auvdock: warning: %s\n", w.c_str());
   }
+  if (!replaying_) {
+    prefetcher_ = std::make_unique<ImagePrefetcher>(frames_.size(), [this](size_t index) {
+      const auto start = Clock::now();
+      DecodedFrame decoded;
+      for (int c = 0; c < 3; ++c) {
+        const CameraFrame* image = frames_[index].images[c];
+        if (image) decoded.images[c] = ReadImage(*image, *cameras_[c], &decoded.problems);
+      }
+      decoded.decode_s = Seconds(Clock::now() - start);
+      return decoded;
+    });
+  }
 }
 
 std::optional<VisionFrame> VisionFrameSource::Next(const Predictor& predict) {
   if (next_ == frames_.size()) return std::nullopt;
   const FrameImages& group = frames_[next_++];
   const int64_t t = group.t_ns;
-  const auto t0 = Clock::now();
   std::array<cv::Mat, 3> images;
-  for (int c = 0; c < 3; ++c) {
-    if (group.images[c]) images[c] = ReadImage(*group.images[c], *cameras_[c], &unreadable_images_);
+  if (prefetcher_) {
+    DecodedFrame decoded = prefetcher_->Take();
+    images = std::move(decoded.images);
+    for (const std::string& problem : decoded.problems) {
+      std::fprintf(stderr, "auvdock: warning: %s; image skipped\n", problem.c_str());
+      ++unreadable_images_;
+    }
+    decode_s_ += decoded.decode_s;
   }
   const auto t1 = Clock::now();
   for (; next_fix_ < fixes_.size() && fixes_[next_fix_].arrival_t_ns() <= t; ++next_fix_) {
@@ -215,7 +232,6 @@ std::optional<VisionFrame> VisionFrameSource::Next(const Predictor& predict) {
   if (vision.empty()) {
     ++no_vision_reasons_[ReasonClass(frame.reason.empty() ? "no identified light" : frame.reason)];
   }
-  decode_s_ += Seconds(t1 - t0);
   frontend_s_ += Seconds(Clock::now() - t1);
   return vision;
 }
