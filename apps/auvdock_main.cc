@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   auvdock::cli::AddRunCommand(app);
   auvdock::cli::AddSmoothCommand(app);
   auvdock::cli::AddDetectCommand(app);
+  auvdock::cli::AddDemoCommand(app);
 
   const std::string unknown =
       auvdock::cli::UnknownWordMessage(app, std::vector<std::string>(argv + 1, argv + argc));

@@ -14,5 +14,6 @@ void AddFrontendCommand(CLI::App& root);
 void AddRunCommand(CLI::App& root);
 void AddSmoothCommand(CLI::App& root);
 void AddDetectCommand(CLI::App& root);
+void AddDemoCommand(CLI::App& root);
 
 }  // namespace auvdock::cli

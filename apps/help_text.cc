@@ -108,4 +108,13 @@ std::string DetectHelp() {
          "--out out/detect --overlay\n";
 }
 
+std::string DemoHelp() {
+  return "\nNeeds: nothing but this binary (the shipped default scenario), or --scenario.\n"
+         "Runs simulate, then frontend, run and smooth on the result, evaluates the three and\n"
+         "prints them side by side. Writes into --out: dataset/, frontend/, run/, smooth/ (each\n"
+         "subcommand's own files), plots/ (run's), evaluation.json, demo.log (every step's\n"
+         "messages).\n"
+         "Example: auvdock demo --out out/demo\n";
+}
+
 }  // namespace auvdock::cli

@@ -13,5 +13,6 @@ std::string FrontendHelp();
 std::string EvaluateHelp();
 std::string PnpHelp();
 std::string DetectHelp();
+std::string DemoHelp();
 
 }  // namespace auvdock::cli

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The README's first command: install what is missing, build, and run the main job on the
-# built-in default scenario: simulate it, run the causal sliding-window estimator on it
-# (trajectory, covariance, go/no-go decisions) and evaluate the result against the ground truth:
-# accuracy by visibility stage, covariance consistency (NEES) and the go/no-go audit, with plots
-# in out/demo/plots/.
+# built-in default scenario (`auvdock demo`): simulate it, run the paper's per-frame baseline, the
+# causal sliding-window estimator (trajectory, covariance, go/no-go decisions) and the batch
+# smoother on it, evaluate the three against the ground truth (accuracy by visibility stage,
+# covariance consistency (NEES), the go/no-go audit) and print them side by side, with plots in
+# out/demo/plots/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
@@ -13,8 +14,6 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j"$(nproc)" --target auvdock_cli
 out=out/demo
 rm -rf "$out"   # the demo's own folder from a previous demo run
-mkdir -p "$out"
-build/bin/auvdock simulate --scenario data/scenarios/default.yaml --out "$out/dataset"
-build/bin/auvdock run --dataset "$out/dataset" --out "$out/run"
-build/bin/auvdock evaluate --dataset "$out/dataset" --estimate "$out/run/trajectory.tum" \
-  --covariance "$out/run/covariance.csv" --decisions "$out/run/decisions.csv" --plots "$out/plots"
+# simulate, frontend (the paper's per-frame baseline), run (the causal window), smooth (the batch
+# smoother), each evaluated; one table side by side; plots of run in out/demo/plots/.
+build/bin/auvdock demo --out "$out"

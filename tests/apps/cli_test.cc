@@ -178,7 +178,8 @@ TEST(Cli, UnknownWordsNameThemselvesAndTheClosestValidOne) {
 // mentions the shipped scenarios or options, their folder as this binary finds it (the build
 // tree's share/auvdock links to data/), which exists.
 TEST(Cli, EachSubcommandsHelpSaysWhatItNeedsAndWrites) {
-  for (const char* sub : {"simulate", "run", "smooth", "frontend", "evaluate", "pnp", "detect"}) {
+  for (const char* sub :
+       {"simulate", "run", "smooth", "frontend", "evaluate", "pnp", "detect", "demo"}) {
     const auto r = test::RunAuvdock({sub, "--help"});
     EXPECT_EQ(r.exit_status, 0) << sub;
     EXPECT_THAT(r.out,
@@ -216,6 +217,33 @@ TEST(Cli, OptionValuesAreCheckedByTheParser) {
     EXPECT_THAT(r.err, HasSubstr(expected));
     EXPECT_THAT(r.err, Not(HasSubstr("not a dataset folder"))) << "checked before any work";
   }
+}
+
+// The demo on 3 s of the default scenario: the three estimators side by side, every step's
+// files kept, and a demo that cannot write where it is told says so in one line.
+TEST(Cli, DemoComparesTheThreeEstimators) {
+  test::TempDir tmp;
+  const std::string scenario = tmp / "s.yaml";
+  test::WriteTextFile(scenario, "name: short\nduration_s: 3.0\ndock: " +
+                                    test::SourcePath("data/docks/t_shape.yaml") + "\n");
+  const std::string out = tmp / "demo";
+  const auto r = test::RunAuvdock({"demo", "--scenario", scenario, "--out", out});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_THAT(r.out, AllOf(HasSubstr("frontend"), HasSubstr("run"), HasSubstr("smooth"),
+                           HasSubstr("position RMSE, all [mm]"), HasSubstr("mean NEES")));
+  for (const char* file : {"dataset/calibration.yaml", "frontend/per_frame.tum",
+                           "run/trajectory.tum", "smooth/covariance.csv", "evaluation.json",
+                           "demo.log"}) {
+    EXPECT_TRUE(fs::exists(fs::path(out) / file)) << file;
+  }
+  const auto record = nlohmann::json::parse(test::ReadTextFile(out + "/evaluation.json"));
+  EXPECT_LT(record.at("run").at("evaluation").at("pos_rmse_m").get<double>(), 0.1);
+  EXPECT_GT(record.at("smooth").at("evaluation").at("nees_mean").get<double>(), 0.0);
+
+  const auto again = test::RunAuvdock({"demo", "--scenario", scenario, "--out", out});
+  EXPECT_EQ(again.exit_status, 2);
+  EXPECT_EQ(CountLines(again.err), 1) << again.err;
+  EXPECT_THAT(again.err, HasSubstr("not empty"));
 }
 
 TEST(Cli, UsageErrorsExitTwo) {
