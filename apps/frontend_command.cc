@@ -1,8 +1,9 @@
 // auvdock frontend --dataset DIR [--dock FILE] --out OUTDIR [--dehaze] [--no-tracking]
 //                  [--matcher ransac|omnidirectional] [--detector contrast|blob]
 //
-// Runs the paper's per-frame pipeline (PaperBaselinePipeline) over every camera frame and
-// writes, flushed frame by frame (a stopped run keeps every frame written before the stop):
+// Runs the paper's per-frame pipeline (PaperBaselinePipeline) over every camera frame (the next
+// frames' images decoded ahead on a thread of their own, image_prefetcher.h) and writes, flushed
+// frame by frame (a stopped run keeps every frame written before the stop):
 //   OUTDIR/detections.csv       timestamp_ns,camera,light_id,u,v,radius,score,cov_uu,cov_uv,
 //                               cov_vv (io/detections_csv.h; light_id -1: not identified; an
 //                               image without a detection: one row with light_id -1 and the
@@ -20,11 +21,11 @@
 #include <memory>
 #include <set>
 
-#include <opencv2/imgcodecs.hpp>
-
+#include "apps/camera_image.h"
 #include "apps/commands.h"
-#include "apps/help_text.h"
 #include "apps/dataset_input.h"
+#include "apps/help_text.h"
+#include "apps/image_prefetcher.h"
 #include "apps/reason_class.h"
 #include "apps/signal_flag.h"
 #include "auvdock/io/csv.h"
@@ -55,26 +56,6 @@ struct FrontendOptions {
 using Clock = std::chrono::steady_clock;
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
-// Reads one image; empty (with a warning) if it cannot be decoded or has the wrong size.
-cv::Mat ReadImage(const CameraFrame& frame, const CameraCalibration& camera, int* n_bad) {
-  cv::Mat image = cv::imread(frame.path, cv::IMREAD_COLOR);
-  std::string problem;
-  if (image.empty()) {
-    problem = "cannot decode";
-  } else if (image.cols != camera.intrinsics.width() || image.rows != camera.intrinsics.height()) {
-    problem = "is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-              ", calibration says " + std::to_string(camera.intrinsics.width()) + "x" +
-              std::to_string(camera.intrinsics.height());
-  }
-  if (!problem.empty()) {
-    std::fprintf(stderr, "auvdock: warning: %s: %s; frame skipped for %s\n", frame.path.c_str(),
-                 problem.c_str(), camera.name.c_str());
-    ++*n_bad;
-    return cv::Mat();
-  }
-  return image;
-}
-
 void RunFrontend(const FrontendOptions& options) {
   const Dataset dataset = LoadDatasetWithDock(options.dataset, options.dock);
   RequireDock(dataset);
@@ -89,7 +70,8 @@ void RunFrontend(const FrontendOptions& options) {
   if (options.matcher == "omnidirectional") {
     pipeline_options.matcher = BaselineMatcher::kOmnidirectional;
   } else if (options.matcher != "ransac") {
-    throw InputError("--matcher: expected ransac or omnidirectional (got '" + options.matcher + "')");
+    throw InputError("--matcher: expected ransac or omnidirectional (got '" + options.matcher +
+                     "')");
   }
   PaperBaselinePipeline pipeline(dataset.calibration, *dataset.dock, pipeline_options);
   for (const std::string& w : pipeline.warnings()) {
@@ -128,18 +110,36 @@ void RunFrontend(const FrontendOptions& options) {
   double decode_s = 0.0, frontend_s = 0.0;
   int n_bad_images = 0, n_frames = 0;
   std::map<VisibilityStage, int> n_by_stage;
-  for (const int64_t t : times) {
-    cancel.ThrowIfCancelled();
-    const auto t0 = Clock::now();
-    std::array<cv::Mat, 3> images;
+  // The next frames' images are decoded on a thread of their own (image_prefetcher.h).
+  const std::vector<int64_t> frame_times(times.begin(), times.end());
+  ImagePrefetcher prefetcher(frame_times.size(), [&](size_t index) {
+    const auto start = Clock::now();
+    DecodedFrame decoded;
     for (int c = 0; c < 3; ++c) {
-      const auto it = frames_by_time[c].find(t);
-      if (it != frames_by_time[c].end()) images[c] = ReadImage(*it->second, *cameras[c], &n_bad_images);
+      const auto it = frames_by_time[c].find(frame_times[index]);
+      if (it == frames_by_time[c].end()) continue;
+      std::string problem;
+      decoded.images[c] = ReadCameraImage(*it->second, *cameras[c], &problem);
+      if (!problem.empty()) {
+        decoded.problems.push_back(it->second->path + ": " + problem + "; frame skipped for " +
+                                   cameras[c]->name);
+      }
     }
+    decoded.decode_s = Seconds(Clock::now() - start);
+    return decoded;
+  });
+  for (const int64_t t : frame_times) {
+    cancel.ThrowIfCancelled();
+    DecodedFrame decoded = prefetcher.Take();
+    for (const std::string& problem : decoded.problems) {
+      std::fprintf(stderr, "auvdock: warning: %s\n", problem.c_str());
+      ++n_bad_images;
+    }
+    const std::array<cv::Mat, 3>& images = decoded.images;
     const auto t1 = Clock::now();
     const BaselineFrame frame = pipeline.Process(t, images[0], images[1], images[2]);
     const auto t2 = Clock::now();
-    decode_s += Seconds(t1 - t0);
+    decode_s += decoded.decode_s;
     frontend_s += Seconds(t2 - t1);
     ++n_frames;
     ++n_by_stage[frame.stage];

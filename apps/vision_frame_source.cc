@@ -1,5 +1,6 @@
 #include "apps/vision_frame_source.h"
 
+#include "apps/camera_image.h"
 #include "apps/dataset_input.h"
 
 #include <algorithm>
@@ -9,8 +10,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "apps/reason_class.h"
 #include "auvdock/estimator/vision_frame_builder.h"
@@ -27,26 +26,6 @@ PaperBaselineOptions PipelineOptions(LightDetectorKind detector) {
 
 using Clock = std::chrono::steady_clock;
 double Seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
-
-// The image of a camera frame; an empty one, and the problem ("PATH: why") appended to
-// `problems`, when it cannot be decoded or has another size than calibrated.
-cv::Mat ReadImage(const CameraFrame& frame, const CameraCalibration& camera,
-                  std::vector<std::string>* problems) {
-  cv::Mat image = cv::imread(frame.path, cv::IMREAD_COLOR);
-  std::string problem;
-  if (image.empty()) {
-    problem = "cannot decode";
-  } else if (image.cols != camera.intrinsics.width() || image.rows != camera.intrinsics.height()) {
-    problem = "is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
-              ", calibration says " + std::to_string(camera.intrinsics.width()) + "x" +
-              std::to_string(camera.intrinsics.height());
-  }
-  if (!problem.empty()) {
-    problems->push_back(frame.path + ": " + problem);
-    return cv::Mat();
-  }
-  return image;
-}
 
 // Images of the stereo pair further apart than this are not one exposure.
 constexpr int64_t kStereoPairToleranceNs = 1000000;
@@ -185,7 +164,10 @@ VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind d
       DecodedFrame decoded;
       for (int c = 0; c < 3; ++c) {
         const CameraFrame* image = frames_[index].images[c];
-        if (image) decoded.images[c] = ReadImage(*image, *cameras_[c], &decoded.problems);
+        if (!image) continue;
+        std::string problem;
+        decoded.images[c] = ReadCameraImage(*image, *cameras_[c], &problem);
+        if (!problem.empty()) decoded.problems.push_back(image->path + ": " + problem);
       }
       decoded.decode_s = Seconds(Clock::now() - start);
       return decoded;

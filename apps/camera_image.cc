@@ -1,0 +1,21 @@
+#include "apps/camera_image.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+namespace auvdock::cli {
+
+cv::Mat ReadCameraImage(const CameraFrame& frame, const CameraCalibration& camera,
+                        std::string* problem) {
+  problem->clear();
+  cv::Mat image = cv::imread(frame.path, cv::IMREAD_COLOR);
+  if (image.empty()) {
+    *problem = "cannot decode";
+  } else if (image.cols != camera.intrinsics.width() || image.rows != camera.intrinsics.height()) {
+    *problem = "is " + std::to_string(image.cols) + "x" + std::to_string(image.rows) +
+               ", calibration says " + std::to_string(camera.intrinsics.width()) + "x" +
+               std::to_string(camera.intrinsics.height());
+  }
+  return problem->empty() ? image : cv::Mat();
+}
+
+}  // namespace auvdock::cli
