@@ -256,7 +256,7 @@ TEST(DetectCli, BadInputIsOneLineAndExitTwo) {
   a = args("o5");
   a.push_back("--colour");
   a.push_back("purple");
-  ExpectOneLineExitTwo(a, "unknown light colour 'purple'");
+  ExpectOneLineExitTwo(a, "--colour: purple not in {white,blue,green,blue_green,red}");
 }
 
 }  // namespace
