@@ -4,6 +4,7 @@
 //    detection on the stereo-left frame 8 s into the run (all six lights at about 5 m);
 //  * BM_DetectBlob: the real-water detector (BlobLightDetector) on the same frame;
 //  * BM_DetectBlobFixedLevels: the same without the clip level and the neck cut (for the ratio);
+//  * BM_OpenCvSimpleBlobDetector: OpenCV's blob detector on the same frame, side by side;
 //  * BM_ImageLevels: its reading of the image's noise and clip level (image_levels.h);
 //  * BM_PerFrame: the whole per-frame path of the paper's baseline (PaperBaselinePipeline::Process
 //    with dehazing on): dehaze + detect + match (hypothesise-and-verify, MatchRansac) + pose.
@@ -25,6 +26,7 @@
 
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "auvdock/sim/docking_trajectory.h"
@@ -117,6 +119,41 @@ BENCHMARK(BM_DetectBlobFixedLevels)
     ->Args({1280, 1024})
     ->Unit(benchmark::kMillisecond);
 
+// OpenCV's own building block on the same frame: cv::SimpleBlobDetector on the gray image,
+// bright blobs of at least 3 px, no shape filters (it has no colour, halo or covariance).
+void BM_OpenCvSimpleBlobDetector(benchmark::State& state) {
+  cv::setNumThreads(1);
+  const cv::Mat frame =
+      RenderFrame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)));
+  cv::SimpleBlobDetector::Params params;
+  params.filterByColor = true;
+  params.blobColor = 255;
+  params.minThreshold = 50;
+  params.maxThreshold = 255;
+  params.thresholdStep = 10;
+  params.filterByArea = true;
+  params.minArea = 3;
+  params.maxArea = 1e5;
+  params.filterByCircularity = false;
+  params.filterByInertia = false;
+  params.filterByConvexity = false;
+  const cv::Ptr<cv::SimpleBlobDetector> detector = cv::SimpleBlobDetector::create(params);
+  size_t blobs = 0;
+  for (auto _ : state) {
+    cv::Mat gray;
+    cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
+    std::vector<cv::KeyPoint> keypoints;
+    detector->detect(gray, keypoints);
+    blobs = keypoints.size();
+    benchmark::DoNotOptimize(keypoints.data());
+  }
+  state.counters["blobs"] = static_cast<double>(blobs);
+}
+BENCHMARK(BM_OpenCvSimpleBlobDetector)
+    ->Args({640, 512})
+    ->Args({1280, 1024})
+    ->Unit(benchmark::kMillisecond);
+
 // The part of BM_DetectBlob that reads the image's own levels (image_levels.h): its noise and
 // clip level, on the same frame's luma.
 void BM_ImageLevels(benchmark::State& state) {
@@ -187,9 +224,8 @@ void BM_PerFrame(benchmark::State& state) {
   const double dehaze_ms = !options.detector.dehaze ? 0.0 : MeanMilliseconds(kRepetitions, [&] {
     benchmark::DoNotOptimize(dehazer.Dehaze(image).image.data);
   });
-  const double dehaze_detect_ms = MeanMilliseconds(kRepetitions, [&] {
-    benchmark::DoNotOptimize(detector.Detect(image).data());
-  });
+  const double dehaze_detect_ms = MeanMilliseconds(
+      kRepetitions, [&] { benchmark::DoNotOptimize(detector.Detect(image).data()); });
   std::optional<std::vector<LightDetection>> left_detections, right_detections, mono_detections;
   if (stereo) {
     left_detections = detector.Detect(left);

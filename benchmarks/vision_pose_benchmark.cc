@@ -1,12 +1,15 @@
 // Cost of the per-frame geometric pose solvers on the default dock (6 coplanar lights) seen by
 // the default rig (640x512, 70 deg): monocular PnP, and the stereo path (left-right matching,
 // linear triangulation with covariance, SVD alignment). Both should be far below a frame
-// period (100 ms at 10 Hz); the light detector and the estimator dominate.
+// period (100 ms at 10 Hz); the light detector and the estimator dominate. BM_OpenCvSolvePnpSqpnp
+// runs OpenCV's SQPnP on the same correspondences, for time and error side by side (counter
+// pos_err_mm: the camera position's error against the truth).
 #include <random>
 #include <vector>
 
 #include <benchmark/benchmark.h>
 #include <Eigen/Geometry>
+#include <opencv2/calib3d.hpp>
 
 #include "auvdock/sim/scenario.h"
 #include "auvdock/vision/pnp_solver.h"
@@ -50,6 +53,11 @@ View Render(const Scenario& scenario, const CameraCalibration& camera, std::mt19
   return view;
 }
 
+// The true T_C_D of the hover view.
+Pose3 TrueCameraFromDock(const CameraCalibration& camera) {
+  return (HoverPose() * camera.T_B_C).Inverse();
+}
+
 void BM_SolvePnp(benchmark::State& state) {
   const Scenario scenario = LoadDefault();
   const CameraCalibration camera = MakeCalibration(scenario).cameras[0];
@@ -58,13 +66,51 @@ void BM_SolvePnp(benchmark::State& state) {
   std::vector<Eigen::Vector2d> pixels;
   for (const LightDetection& d : view.detections) pixels.push_back(d.uv);
   if (view.points_D.size() != 6) state.SkipWithError("not all 6 lights in view");
+  PnpResult result;
   for (auto _ : state) {
-    const PnpResult result = SolvePnp(view.points_D, pixels, camera.intrinsics);
+    result = SolvePnp(view.points_D, pixels, camera.intrinsics);
     benchmark::DoNotOptimize(result);
     if (!result.ok) state.SkipWithError(result.reason.c_str());
   }
+  // The camera position's error against the truth (mm), for the side-by-side with OpenCV.
+  const Pose3 truth = TrueCameraFromDock(camera);
+  state.counters["pos_err_mm"] = 1e3 * (result.T_C_D.Inverse().p - truth.Inverse().p).norm();
 }
 BENCHMARK(BM_SolvePnp)->Unit(benchmark::kMicrosecond);
+
+// OpenCV's own building block on the same correspondences: cv::solvePnP with SQPnP (a global
+// solver; no covariance). Side by side with BM_SolvePnp in one run: time and the same error.
+void BM_OpenCvSolvePnpSqpnp(benchmark::State& state) {
+  const Scenario scenario = LoadDefault();
+  const CameraCalibration camera = MakeCalibration(scenario).cameras[0];
+  std::mt19937 rng(1);
+  const View view = Render(scenario, camera, &rng);
+  if (view.points_D.size() != 6) state.SkipWithError("not all 6 lights in view");
+  std::vector<cv::Point3d> object;
+  std::vector<cv::Point2d> image;
+  for (size_t i = 0; i < view.points_D.size(); ++i) {
+    object.emplace_back(view.points_D[i].x(), view.points_D[i].y(), view.points_D[i].z());
+    image.emplace_back(view.detections[i].uv.x(), view.detections[i].uv.y());
+  }
+  const auto& k = camera.intrinsics;
+  const cv::Matx33d K(k.fx(), 0, k.cx(), 0, k.fy(), k.cy(), 0, 0, 1);
+  const auto& d = k.distortion();
+  const std::vector<double> distortion(d.begin(), d.end());
+  cv::Mat rvec, tvec;
+  for (auto _ : state) {
+    const bool ok =
+        cv::solvePnP(object, image, K, distortion, rvec, tvec, false, cv::SOLVEPNP_SQPNP);
+    benchmark::DoNotOptimize(ok);
+    if (!ok) state.SkipWithError("cv::solvePnP failed");
+  }
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  const cv::Mat camera_in_dock = -R.t() * tvec;
+  const Eigen::Vector3d p(camera_in_dock.at<double>(0), camera_in_dock.at<double>(1),
+                          camera_in_dock.at<double>(2));
+  state.counters["pos_err_mm"] = 1e3 * (p - TrueCameraFromDock(camera).Inverse().p).norm();
+}
+BENCHMARK(BM_OpenCvSolvePnpSqpnp)->Unit(benchmark::kMicrosecond);
 
 void BM_TriangulateAndAlign(benchmark::State& state) {
   const Scenario scenario = LoadDefault();
