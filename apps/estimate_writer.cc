@@ -7,6 +7,7 @@
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/pose_covariance_csv.h"
 #include "auvdock/io/rejections_csv.h"
+#include "auvdock/io/sensor_csv.h"
 #include "auvdock/io/staged_directory.h"
 
 namespace fs = std::filesystem;
@@ -22,15 +23,23 @@ std::string PrepareDirectory(const std::string& out_dir) {
 
 }  // namespace
 
-EstimateWriter::EstimateWriter(const std::string& out_dir)
+EstimateWriter::EstimateWriter(const std::string& out_dir, bool euroc_csv)
     : out_dir_(PrepareDirectory(out_dir)),
       trajectory_(std::make_unique<TumWriter>(out_dir + "/trajectory.tum")),
       covariance_(out_dir + "/covariance.csv", PoseCovarianceCsvHeader()),
       decisions_(out_dir + "/decisions.csv", DecisionsCsvHeader()),
-      rejections_(out_dir + "/rejections.csv", RejectionsCsvHeader()) {}
+      rejections_(out_dir + "/rejections.csv", RejectionsCsvHeader()) {
+  if (euroc_csv) {
+    estimate_csv_ = std::make_unique<CsvWriter>(out_dir + "/estimate.csv", kGroundTruthCsvHeader);
+  }
+}
 
 void EstimateWriter::Write(const EstimatorOutput& output, const GoNoGoDecision& decision) {
   trajectory_->Append({output.t_ns, output.T_D_B});
+  if (estimate_csv_) {
+    estimate_csv_->Line(GroundTruthCsvRow(
+        {output.t_ns, output.T_D_B, output.v_D, output.bias.gyro, output.bias.accel}));
+  }
   if (output.covariance_ok) {
     const Eigen::Matrix<double, 6, 6, Eigen::RowMajor> row_major = output.covariance;
     covariance_.Row(output.t_ns, std::vector<double>(row_major.data(), row_major.data() + 36));

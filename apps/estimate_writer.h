@@ -10,6 +10,10 @@
 //   rejections.csv   timestamp_ns, sensor, statistic, reason: every measurement the estimator
 //                    left out (io/rejections_csv.h)
 //   summary.json     written last, atomically (see WriteSummary)
+//   estimate.csv     (--euroc-csv) the estimated state in EuRoC's state_groundtruth_estimate0
+//                    columns (io/sensor_csv.h, the dataset's groundtruth/data.csv format):
+//                    timestamp_ns, p_D_B, q_D_B (w x y z), v_D, gyro bias, accelerometer bias;
+//                    the format of `evo_traj euroc`; our own ground-truth reader reads it back
 #pragma once
 
 #include <string>
@@ -26,7 +30,8 @@ namespace auvdock::cli {
 
 class EstimateWriter {
  public:
-  explicit EstimateWriter(const std::string& out_dir);
+  // euroc_csv: also write estimate.csv (above).
+  explicit EstimateWriter(const std::string& out_dir, bool euroc_csv = false);
 
   void Write(const EstimatorOutput& output, const GoNoGoDecision& decision);
   void WriteNoEstimate(int64_t t_ns, const GoNoGoDecision& decision);
@@ -41,6 +46,7 @@ class EstimateWriter {
   CsvWriter covariance_;
   CsvWriter decisions_;
   CsvWriter rejections_;
+  std::unique_ptr<CsvWriter> estimate_csv_;  // null without --euroc-csv
 };
 
 }  // namespace auvdock::cli

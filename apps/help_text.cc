@@ -36,7 +36,8 @@ const char* kEstimateFiles =
     "                   dtheta_D (rad): perturbations in the dock frame\n"
     "  decisions.csv    timestamp_ns, GO or NO-GO, reason (every frame)\n"
     "  rejections.csv   every measurement left out: timestamp_ns, sensor, statistic, reason\n"
-    "  summary.json     counts, why frames had no vision, timing (written last)\n";
+    "  summary.json     counts, why frames had no vision, timing (written last)\n"
+    "  estimate.csv     (--euroc-csv) the state in EuRoC's ground-truth columns\n";
 
 }  // namespace
 

@@ -13,9 +13,9 @@
 
 #include "apps/cli_validators.h"
 #include "apps/commands.h"
-#include "apps/help_text.h"
 #include "apps/dataset_input.h"
 #include "apps/estimate_writer.h"
+#include "apps/help_text.h"
 #include "apps/run_summary.h"
 #include "apps/sensor_feed.h"
 #include "apps/signal_flag.h"
@@ -33,6 +33,7 @@ struct RunOptions {
   std::string out;
   std::string config;
   bool quiet = false;
+  bool euroc_csv = false;  // --euroc-csv: also estimate.csv (estimate_writer.h)
   std::string detector = "contrast";
   double sync_tolerance_ms = -1.0;  // < 0: half the shortest frame interval
   std::string detections;           // replay this detections.csv instead of the images
@@ -51,8 +52,9 @@ void Run(const RunOptions& options) {
                            SyncToleranceNs(options.sync_tolerance_ms), options.detections);
   SlidingWindowEstimator estimator(dataset.calibration, RequireDock(dataset), config.estimator);
   GoNoGo go_no_go(config.go_no_go);
-  EstimateWriter writer(options.out);
-  for (const std::string& row : skipped_rows) std::fprintf(stderr, "auvdock: run: %s\n", row.c_str());
+  EstimateWriter writer(options.out, options.euroc_csv);
+  for (const std::string& row : skipped_rows)
+    std::fprintf(stderr, "auvdock: run: %s\n", row.c_str());
 
   const CancellationToken cancel = InstallSignalCancellation();
   RunCounters counters;
@@ -80,10 +82,9 @@ void Run(const RunOptions& options) {
         counters.symmetry_unresolved += out->symmetry_unresolved;
         writer.Write(*out, decision);
       } else {
-        const std::string why = estimator.initialized() ? "estimator reset"
-                                : estimator.init_refusal().empty()
-                                    ? "waiting for a per-frame pose"
-                                    : estimator.init_refusal();
+        const std::string why = estimator.initialized()            ? "estimator reset"
+                                : estimator.init_refusal().empty() ? "waiting for a per-frame pose"
+                                                                   : estimator.init_refusal();
         writer.WriteNoEstimate(
             frame->t_ns,
             go_no_go.NoEstimate(estimator.initialized() ? why : "not initialised (" + why + ")"));
@@ -115,7 +116,8 @@ void Run(const RunOptions& options) {
   PrintGivenIdentities(source);
   std::printf("  per frame: decode %.2f ms, front-end %.2f ms, back-end %.2f ms\n",
               1e3 * source.decode_s() / counters.frames,
-              1e3 * source.frontend_s() / counters.frames, 1e3 * counters.backend_s / counters.frames);
+              1e3 * source.frontend_s() / counters.frames,
+              1e3 * counters.backend_s / counters.frames);
 }
 
 }  // namespace
@@ -139,6 +141,9 @@ void AddRunCommand(CLI::App& root) {
   sub->add_option("--detections", options->detections,
                   "Replay these light detections (detections.csv: `simulate` with render_images "
                   "false, `frontend`, or a detector of your own) instead of the images");
+  sub->add_flag("--euroc-csv", options->euroc_csv,
+                "Also write estimate.csv: the state in EuRoC's ground-truth columns (timestamp, "
+                "p, q w x y z, v, gyro bias, accelerometer bias), the format of evo_traj euroc");
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { Run(*options); });
 }

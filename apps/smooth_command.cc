@@ -12,9 +12,9 @@
 
 #include "apps/cli_validators.h"
 #include "apps/commands.h"
-#include "apps/help_text.h"
 #include "apps/dataset_input.h"
 #include "apps/estimate_writer.h"
+#include "apps/help_text.h"
 #include "apps/run_summary.h"
 #include "apps/sensor_feed.h"
 #include "apps/signal_flag.h"
@@ -33,6 +33,7 @@ struct SmoothOptions {
   std::string out;
   std::string config;
   bool quiet = false;
+  bool euroc_csv = false;  // --euroc-csv: also estimate.csv (estimate_writer.h)
   std::string detector = "contrast";
   double sync_tolerance_ms = -1.0;  // < 0: half the shortest frame interval
   std::string detections;           // replay this detections.csv instead of the images
@@ -50,7 +51,7 @@ void Smooth(const SmoothOptions& options) {
   VisionFrameSource source(dataset, ParseDetectorKind(options.detector),
                            SyncToleranceNs(options.sync_tolerance_ms), options.detections);
   SlidingWindowEstimator estimator(dataset.calibration, RequireDock(dataset), config.estimator);
-  EstimateWriter writer(options.out);
+  EstimateWriter writer(options.out, options.euroc_csv);
 
   const CancellationToken cancel = InstallSignalCancellation();
   RunCounters counters;
@@ -88,12 +89,11 @@ void Smooth(const SmoothOptions& options) {
     };
   }
   const auto t0 = Clock::now();
-  const BatchResult result = SmoothBatch(dataset.calibration, *dataset.dock, frames, dataset.imu,
-                                         estimator.History(), config.estimator, batch,
-                                         NavigationSamples{dataset.depth, dataset.dvl,
-                                                           estimator.stats().dvl_variance_factor,
-                                                           estimator.stats().depth_variance_factor,
-                                                           dataset.acoustic});
+  const BatchResult result = SmoothBatch(
+      dataset.calibration, *dataset.dock, frames, dataset.imu, estimator.History(),
+      config.estimator, batch,
+      NavigationSamples{dataset.depth, dataset.dvl, estimator.stats().dvl_variance_factor,
+                        estimator.stats().depth_variance_factor, dataset.acoustic});
   counters.backend_s += Seconds(Clock::now() - t0);
   if (!options.quiet) std::fprintf(stderr, "\n");
 
@@ -141,11 +141,11 @@ void Smooth(const SmoothOptions& options) {
                               {"coordinates", result.vision_errors.coordinates},
                               {"lag_pairs", result.vision_errors.lag_pairs}};
   writer.WriteSummary(summary);
-  std::printf("smooth: %d frames -> %s: %d estimates in %d segment(s), %d GO; batch %d "
-              "iterations, cost %.6g -> %.6g\n",
-              counters.frames, options.out.c_str(), result.stats.frames_with_output,
-              result.segments, counters.go, result.iterations, result.initial_cost,
-              result.final_cost);
+  std::printf(
+      "smooth: %d frames -> %s: %d estimates in %d segment(s), %d GO; batch %d "
+      "iterations, cost %.6g -> %.6g\n",
+      counters.frames, options.out.c_str(), result.stats.frames_with_output, result.segments,
+      counters.go, result.iterations, result.initial_cost, result.final_cost);
   for (const auto& [reason, count] : source.no_vision_reasons()) {
     std::printf("  no vision: %d frames: %s\n", count, reason.c_str());
   }
@@ -174,6 +174,9 @@ void AddSmoothCommand(CLI::App& root) {
   sub->add_option("--detections", options->detections,
                   "Replay these light detections (detections.csv: `simulate` with render_images "
                   "false, `frontend`, or a detector of your own) instead of the images");
+  sub->add_flag("--euroc-csv", options->euroc_csv,
+                "Also write estimate.csv: the state in EuRoC's ground-truth columns (timestamp, "
+                "p, q w x y z, v, gyro bias, accelerometer bias), the format of evo_traj euroc");
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { Smooth(*options); });
 }

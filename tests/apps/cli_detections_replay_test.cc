@@ -20,6 +20,7 @@
 #include "auvdock/io/decisions_csv.h"
 #include "auvdock/io/detections_csv.h"
 #include "auvdock/io/pose_covariance_csv.h"
+#include "auvdock/io/sensor_csv.h"
 #include "auvdock/io/tum_io.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/temp_dir.h"
@@ -40,8 +41,8 @@ class DetectionsReplayCli : public ::testing::Test {
     const std::string scenario = *tmp_ / "s.yaml";
     test::WriteTextFile(scenario, "name: short\nduration_s: 12.0\ndock: " +
                                       test::SourcePath("data/docks/t_shape.yaml") + "\n");
-    const auto r = test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset_,
-                                     "--detections-only", "--quiet"});
+    const auto r = test::RunAuvdock(
+        {"simulate", "--scenario", scenario, "--out", dataset_, "--detections-only", "--quiet"});
     ASSERT_EQ(r.exit_status, 0) << r.err;
   }
   static void TearDownTestSuite() { delete tmp_; }
@@ -74,9 +75,9 @@ TEST_F(DetectionsReplayCli, RunAndSmoothReplayTheDetections) {
                                      dataset_ + "/detections.csv", "--out", out, "--quiet"});
     ASSERT_EQ(r.exit_status, 0) << command << ": " << r.err;
     EXPECT_GE(ReadTumTrajectory(out + "/trajectory.tum").size(), 110u) << command;
-    const auto e = test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate",
-                                     out + "/trajectory.tum", "--covariance",
-                                     out + "/covariance.csv", "--json"});
+    const auto e =
+        test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate", out + "/trajectory.tum",
+                          "--covariance", out + "/covariance.csv", "--json"});
     ASSERT_EQ(e.exit_status, 0) << e.err;
     const nlohmann::json report = nlohmann::json::parse(e.out);
     // Stereo at 4-10 m: a sanity bound (the image path's own test uses 0.3 m on 3 s).
@@ -96,8 +97,8 @@ TEST_F(DetectionsReplayCli, TheDockComesFromDockWhenTheDatasetHasNone) {
   const fs::path bare = *tmp_ / "bare";
   fs::copy(dataset_, bare, fs::copy_options::recursive);
   fs::remove(bare / "dock.yaml");
-  const std::vector<std::string> run = {"run", "--dataset", bare.string(), "--detections",
-                                        dataset_ + "/detections.csv", "--quiet"};
+  const std::vector<std::string> run = {
+      "run", "--dataset", bare.string(), "--detections", dataset_ + "/detections.csv", "--quiet"};
   auto with = [&](std::vector<std::string> extra) {
     std::vector<std::string> args = run;
     args.insert(args.end(), extra.begin(), extra.end());
@@ -108,8 +109,7 @@ TEST_F(DetectionsReplayCli, TheDockComesFromDockWhenTheDatasetHasNone) {
   EXPECT_THAT(without.err, HasSubstr("--dock"));
   EXPECT_EQ(std::count(without.err.begin(), without.err.end(), '\n'), 1) << without.err;
 
-  const auto given =
-      with({"--dock", dataset_ + "/dock.yaml", "--out", *tmp_ / "bare_docked"});
+  const auto given = with({"--dock", dataset_ + "/dock.yaml", "--out", *tmp_ / "bare_docked"});
   ASSERT_EQ(given.exit_status, 0) << given.err;
   EXPECT_GE(ReadTumTrajectory(*tmp_ / "bare_docked/trajectory.tum").size(), 110u);
 
@@ -118,6 +118,27 @@ TEST_F(DetectionsReplayCli, TheDockComesFromDockWhenTheDatasetHasNone) {
   const auto malformed = with({"--dock", bad, "--out", *tmp_ / "bare_bad"});
   EXPECT_EQ(malformed.exit_status, 2);
   EXPECT_THAT(malformed.err, HasSubstr("bad_dock.yaml"));
+}
+
+// --euroc-csv: the state in EuRoC's ground-truth columns, read back by the ground-truth reader,
+// pose for pose the trajectory.tum of the same run.
+TEST_F(DetectionsReplayCli, TheEstimateAlsoInEurocColumns) {
+  const std::string out = *tmp_ / "euroc_out";
+  const auto r =
+      test::RunAuvdock({"run", "--dataset", dataset_, "--detections", dataset_ + "/detections.csv",
+                        "--euroc-csv", "--out", out, "--quiet"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const std::vector<GroundTruthState> states = ReadGroundTruthCsv(out + "/estimate.csv");
+  const Trajectory tum = ReadTumTrajectory(out + "/trajectory.tum");
+  ASSERT_EQ(states.size(), tum.size());
+  ASSERT_GE(states.size(), 110u);
+  for (size_t i = 0; i < states.size(); ++i) {
+    EXPECT_NEAR(states[i].T_D_B.p.x(), tum[i].T_D_B.p.x(), 1e-9);
+    EXPECT_NEAR(states[i].T_D_B.p.z(), tum[i].T_D_B.p.z(), 1e-9);
+    EXPECT_NEAR(std::abs(states[i].T_D_B.q.dot(tum[i].T_D_B.q)), 1.0, 1e-12);
+    EXPECT_LT(states[i].v_D.norm(), 3.0);  // a docking approach, not a blow-up
+  }
+  EXPECT_FALSE(fs::exists(*tmp_ / "run_out/estimate.csv")) << "only with --euroc-csv";
 }
 
 int CountLines(const std::string& path) {
@@ -155,8 +176,7 @@ TEST_F(DetectionsReplayCli, AnInterruptedRunKeepsEveryRowItWrote) {
       const auto next = decided.lower_bound(pose.t_ns - 1000);
       EXPECT_TRUE(next != decided.end() && *next <= pose.t_ns + 1000) << pose.t_ns;
     }
-    const nlohmann::json summary =
-        nlohmann::json::parse(test::ReadTextFile(out + "/summary.json"));
+    const nlohmann::json summary = nlohmann::json::parse(test::ReadTextFile(out + "/summary.json"));
     EXPECT_TRUE(summary.at("interrupted").get<bool>());
   }
 }
@@ -190,11 +210,10 @@ TEST(FrontendDetectionsReplayCli, FrontendDetectionsReplayThroughRun) {
   test::WriteTextFile(scenario, "name: short\nduration_s: 2.0\ndock: " +
                                     test::SourcePath("data/docks/t_shape.yaml") + "\n");
   const std::string ds = tmp / "ds", fe = tmp / "fe", out = tmp / "run";
-  ASSERT_EQ(test::RunAuvdock({"simulate", "--scenario", scenario, "--out", ds, "--quiet"})
-                .exit_status,
-            0);
-  ASSERT_EQ(test::RunAuvdock({"frontend", "--dataset", ds, "--out", fe, "--quiet"}).exit_status,
-            0);
+  ASSERT_EQ(
+      test::RunAuvdock({"simulate", "--scenario", scenario, "--out", ds, "--quiet"}).exit_status,
+      0);
+  ASSERT_EQ(test::RunAuvdock({"frontend", "--dataset", ds, "--out", fe, "--quiet"}).exit_status, 0);
   // Every image of the 21 frames is in the file, including those that saw nothing.
   EXPECT_EQ(ReadDetectionsCsv(fe + "/detections.csv").size(), 3u * 21u);
   const auto r = test::RunAuvdock(
