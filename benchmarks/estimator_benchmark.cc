@@ -3,10 +3,13 @@
 // 0.3 px; tests/testing/synthetic_vision.h), so that only the back-end is timed.
 // Per iteration: the whole run. Counters: median and p99 of the per-frame update (IMU samples
 // of the frame + AddVisionFrame: preintegrate, solve, gate, marginalize, covariance) and the
-// back-end's speed as a multiple of real time.
+// back-end's speed as a multiple of real time, and the position RMSE of the outputs against the
+// truth (pos_rmse_mm). BM_WindowSize: windows of 5, 10 and 20 frames in one run.
 // Budget (issue 4): window update p99 <= 5 ms with a window of 10; back-end >= 50x real time.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <optional>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -30,17 +33,27 @@ void RunWindow(benchmark::State& state, bool covariance, int window) {
   options.window_size = window;
   std::vector<double> update_ms;
   double total_s = 0.0;
+  double squared_error_sum = 0.0;  // position error against the truth, over the outputs
+  int n_outputs = 0;
   for (auto _ : state) {
     SlidingWindowEstimator estimator(run.calibration, run.dock, options);
     size_t next_imu = 0;
     update_ms.clear();
+    squared_error_sum = 0.0;
+    n_outputs = 0;
     const auto start = std::chrono::steady_clock::now();
     for (const VisionFrame& frame : run.frames) {
       const auto t0 = std::chrono::steady_clock::now();
       while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= frame.t_ns) {
         estimator.AddImu(run.imu[next_imu++]);
       }
-      benchmark::DoNotOptimize(estimator.AddVisionFrame(frame));
+      const std::optional<EstimatorOutput> output = estimator.AddVisionFrame(frame);
+      benchmark::DoNotOptimize(output);
+      if (output) {
+        const size_t k = static_cast<size_t>(&frame - run.frames.data());
+        squared_error_sum += (output->T_D_B.p - run.truth[k].T_D_B.p).squaredNorm();
+        ++n_outputs;
+      }
       update_ms.push_back(
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     }
@@ -53,12 +66,19 @@ void RunWindow(benchmark::State& state, bool covariance, int window) {
   state.counters["p99_ms"] = update_ms[static_cast<size_t>(0.99 * (update_ms.size() - 1))];
   state.counters["max_ms"] = update_ms.back();
   state.counters["x_realtime"] = duration_s / total_s;
+  state.counters["pos_rmse_mm"] = 1e3 * std::sqrt(squared_error_sum / std::max(1, n_outputs));
 }
 
 void BM_WindowUpdate(benchmark::State& state) { RunWindow(state, true, 10); }
 void BM_WindowUpdateNoCovariance(benchmark::State& state) { RunWindow(state, false, 10); }
 BENCHMARK(BM_WindowUpdate)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_WindowUpdateNoCovariance)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// Window sizes side by side in one run: the cost per frame against the position error.
+void BM_WindowSize(benchmark::State& state) {
+  RunWindow(state, true, static_cast<int>(state.range(0)));
+}
+BENCHMARK(BM_WindowSize)->Arg(5)->Arg(10)->Arg(20)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 }  // namespace auvdock
