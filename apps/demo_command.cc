@@ -11,6 +11,7 @@
 // subcommand's files), plots/ (evaluate --plots of run), evaluation.json (the three evaluations
 // and the wall times) and demo.log (every step's standard error).
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -54,8 +55,8 @@ class DemoSteps {
       std::fflush(stdout);
     }
     const ChildResult result = RunSelf(args, log_);
-    if (result.exit_status == 130 || result.exit_status == 128 + 2 ||
-        result.exit_status == 128 + 15) {
+    // 130: the step stopped on SIGINT (its own exit status, or the signal's); 143: SIGTERM.
+    if (result.exit_status == 128 + SIGINT || result.exit_status == 128 + SIGTERM) {
       throw Cancelled();
     }
     if (result.exit_status != 0) {
