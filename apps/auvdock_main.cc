@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   auvdock::cli::AddPnpCommand(app);
   auvdock::cli::AddRunCommand(app);
   auvdock::cli::AddSmoothCommand(app);
+  auvdock::cli::AddCrlbCommand(app);
   auvdock::cli::AddDetectCommand(app);
   auvdock::cli::AddDemoCommand(app);
 

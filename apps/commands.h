@@ -13,6 +13,7 @@ void AddPnpCommand(CLI::App& root);
 void AddFrontendCommand(CLI::App& root);
 void AddRunCommand(CLI::App& root);
 void AddSmoothCommand(CLI::App& root);
+void AddCrlbCommand(CLI::App& root);
 void AddDetectCommand(CLI::App& root);
 void AddDemoCommand(CLI::App& root);
 

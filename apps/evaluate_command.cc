@@ -37,6 +37,7 @@ struct EvaluateOptions {
   std::string estimate_path;
   std::string covariance_path;  // optional: NEES against the truth
   std::string decisions_path;   // optional: go/no-go audit
+  std::string bound_path;       // optional: Cramér–Rao bound (crlb) beside the errors
   double allowed_lateral_error_m = GoNoGoOptions().allowed_lateral_error_m;
   bool json = false;
   std::string align = "none";
@@ -56,6 +57,15 @@ void AddNeesJson(const ErrorStats& stats, nlohmann::ordered_json* j) {
   (*j)["nees_above_95"] = stats.nees_above_95;
 }
 
+// NaN (no bound in a group) is written as null by nlohmann::json.
+void AddBoundJson(const ErrorStats& stats, nlohmann::ordered_json* j) {
+  (*j)["bound_n"] = stats.bound_n;
+  (*j)["bound_pos_rms_m"] = stats.bound_pos_rms_m;
+  (*j)["bound_att_rms_rad"] = stats.bound_att_rms_rad;
+  (*j)["pos_rmse_at_bound_m"] = stats.pos_rmse_at_bound_m;
+  (*j)["att_rmse_at_bound_rad"] = stats.att_rmse_at_bound_rad;
+}
+
 nlohmann::ordered_json ReportJson(const EvaluateOptions& options, const EvaluationReport& report) {
   nlohmann::ordered_json j;
   j["dataset"] = options.dataset_dir;
@@ -71,6 +81,10 @@ nlohmann::ordered_json ReportJson(const EvaluateOptions& options, const Evaluati
   if (!options.covariance_path.empty()) {
     j["covariance"] = options.covariance_path;
     AddNeesJson(report.overall, &j);
+  }
+  if (!options.bound_path.empty()) {
+    j["bound"] = options.bound_path;
+    AddBoundJson(report.overall, &j);
   }
   // NaN RMSEs (no pair) are written as null by nlohmann::json.
   j["rpe"] = {{"delta_s", report.rpe.delta_s},
@@ -104,6 +118,7 @@ nlohmann::ordered_json ReportJson(const EvaluateOptions& options, const Evaluati
                                           {"att_max_abs_rad", Vector3Json(stats.att_max_abs_rad)},
                                           {"pos_mean_m", Vector3Json(stats.pos_mean_m)}};
     if (stats.nees_n > 0) AddNeesJson(stats, &stages[VisibilityStageName(stage)]);
+    if (stats.bound_n > 0) AddBoundJson(stats, &stages[VisibilityStageName(stage)]);
   }
   j["stages"] = stages;
   return j;
@@ -160,6 +175,19 @@ void PrintTable(const EvaluateOptions& options, const EvaluationReport& report) 
     }
   }
 
+  if (!options.bound_path.empty()) {
+    std::printf("\n%-20s %7s %9s %9s %9s %9s   (rmse over the poses with a bound)\n",
+                "Cramer-Rao bound", "n", "pos rmse", "bound", "att rmse", "bound");
+    std::printf("%-20s %7s %9s %9s %9s %9s\n", "", "", "[m]", "[m]", "[deg]", "[deg]");
+    for (const Row& row : rows) {
+      const ErrorStats& s = *row.stats;
+      if (s.bound_n == 0) continue;
+      std::printf("  %-18s %7d %9.4f %9.4f %9.3f %9.3f\n", row.name, s.bound_n,
+                  s.pos_rmse_at_bound_m, s.bound_pos_rms_m, s.att_rmse_at_bound_rad * kRadToDeg,
+                  s.bound_att_rms_rad * kRadToDeg);
+    }
+  }
+
   if (!options.decisions_path.empty()) {
     const DecisionAudit& a = report.decisions;
     std::printf("\ngo/no-go audit (allowed lateral error %.3f m)\n",
@@ -205,6 +233,10 @@ void RunEvaluate(const EvaluateOptions& options) {
     if (reports.covariances.empty()) {
       throw InputError(options.covariance_path + ": no covariance rows");
     }
+  }
+  if (!options.bound_path.empty()) {
+    reports.bounds = ReadPoseCovarianceCsv(options.bound_path);
+    if (reports.bounds.empty()) throw InputError(options.bound_path + ": no bound rows");
   }
   if (!options.decisions_path.empty()) {
     reports.decisions = ReadDecisionsCsv(options.decisions_path);
@@ -256,6 +288,10 @@ void AddEvaluateCommand(CLI::App& root) {
   sub->add_option("--decisions", options->decisions_path,
                   "The go/no-go decisions (decisions.csv of run/smooth): adds the audit of GO "
                   "against the true lateral error")
+      ->type_name("FILE.csv");
+  sub->add_option("--bound", options->bound_path,
+                  "The Cramer-Rao bound of every pose (auvdock crlb): its RMS beside the "
+                  "estimate's errors")
       ->type_name("FILE.csv");
   sub->add_option("--allowed-lateral-error", options->allowed_lateral_error_m,
                   "Lateral error a GO must stay within, metres (default 0.10, as go/no-go)")

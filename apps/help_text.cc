@@ -70,6 +70,17 @@ std::string SmoothHelp() {
          "Example: auvdock smooth --dataset out/sim --out out/smooth\n";
 }
 
+std::string CrlbHelp() {
+  return "\nNeeds: what smooth needs, and the ground truth (groundtruth/data.csv): the bound is the\n"
+         "batch problem's information at the true states, with the configured noise models\n"
+         "(--config), marginalised per pose. No estimator can do better on average.\n"
+         "Writes --out FILE: the bound in the covariance.csv format (timestamp_ns + the 6x6\n"
+         "covariance, row-major, dp_D (m), dtheta_D (rad)); evaluate --bound FILE sets an\n"
+         "estimate's errors beside it.\n" +
+         Shipped("Estimator options (--config)", "estimator") +
+         "Example: auvdock crlb --dataset out/sim --out out/crlb.csv\n";
+}
+
 std::string FrontendHelp() {
   return "\nNeeds: a dataset folder with camera images and a dock (dock.yaml, or --dock).\n"
          "The paper's per-frame baseline: no IMU, no filter, each frame on its own.\n"

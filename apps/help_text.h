@@ -9,6 +9,7 @@ namespace auvdock::cli {
 std::string SimulateHelp();
 std::string RunHelp();     // run
 std::string SmoothHelp();  // smooth
+std::string CrlbHelp();
 std::string FrontendHelp();
 std::string EvaluateHelp();
 std::string PnpHelp();

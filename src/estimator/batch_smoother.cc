@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -121,6 +122,9 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   vision_options.correlated_pixel_variance = CorrelatedVisionVariance(
       estimator_options.smoother_vision_floor_px,
       estimator_options.smoother_vision_correlation_time_s, MedianStateInterval(states));
+  if (options.information_at_warm_start) {
+    vision_options.huber_sigmas = std::numeric_limits<double>::infinity();
+  }
 
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -235,7 +239,8 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
-  solver.max_num_iterations = options.max_iterations;
+  // No iteration: Solve only evaluates the cost at the warm start.
+  solver.max_num_iterations = options.information_at_warm_start ? 0 : options.max_iterations;
   solver.num_threads = 1;
   solver.logging_type = ceres::SILENT;
   ProgressCallback callback(options.progress);

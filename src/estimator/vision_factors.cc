@@ -19,8 +19,10 @@ namespace {
 
 constexpr double kZero3[3] = {0.0, 0.0, 0.0};
 
+// huber_sigmas = +infinity: no robust loss (plain least squares, only the weight).
 ceres::LossFunction* WeightedHuber(double huber_sigmas, double weight) {
-  ceres::LossFunction* huber = new ceres::HuberLoss(huber_sigmas);
+  ceres::LossFunction* huber =
+      std::isinf(huber_sigmas) ? nullptr : new ceres::HuberLoss(huber_sigmas);
   if (weight == 1.0) return huber;
   return new ceres::ScaledLoss(huber, weight, ceres::TAKE_OWNERSHIP);
 }

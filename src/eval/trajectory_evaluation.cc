@@ -26,6 +26,7 @@ struct MatchedPose {
   Pose3 T_true;
   VisibilityStage stage = VisibilityStage::kUnknown;
   const Eigen::Matrix<double, 6, 6>* covariance = nullptr;  // when the estimate has one here
+  const Eigen::Matrix<double, 6, 6>* bound = nullptr;       // when a bound is given here
 };
 
 // e^T Sigma^-1 e with e = Minus(T_est, T_true) in the PoseManifold tangent space.
@@ -61,6 +62,16 @@ class ErrorAccumulator {
     if (nees > kNees95) ++nees_above_;
   }
 
+  // The bound at a pose, with that pose's own errors.
+  void AddBound(const Pose3& T_est, const Pose3& T_true, const Eigen::Matrix<double, 6, 6>& bound) {
+    ++bound_n_;
+    bound_pos_sum_ += bound.topLeftCorner<3, 3>().trace();
+    bound_att_sum_ += bound.bottomRightCorner<3, 3>().trace();
+    at_bound_pos_sq_ += (T_est.p - T_true.p).squaredNorm();
+    const double angle = RotationAngleBetween(T_true.q, T_est.q);
+    at_bound_att_sq_ += angle * angle;
+  }
+
   int n() const { return n_; }
 
   ErrorStats Stats() const {
@@ -76,6 +87,14 @@ class ErrorAccumulator {
     stats.nees_mean = nees_n_ > 0 ? nees_sum_ / nees_n_ : std::nan("");
     stats.nees_above_95 =
         nees_n_ > 0 ? static_cast<double>(nees_above_) / nees_n_ : std::nan("");
+    stats.bound_n = bound_n_;
+    const auto rms = [&](double sum) {
+      return bound_n_ > 0 ? std::sqrt(sum / bound_n_) : std::nan("");
+    };
+    stats.bound_pos_rms_m = rms(bound_pos_sum_);
+    stats.bound_att_rms_rad = rms(bound_att_sum_);
+    stats.pos_rmse_at_bound_m = rms(at_bound_pos_sq_);
+    stats.att_rmse_at_bound_rad = rms(at_bound_att_sq_);
     return stats;
   }
 
@@ -89,6 +108,9 @@ class ErrorAccumulator {
   int nees_n_ = 0;
   int nees_above_ = 0;
   double nees_sum_ = 0.0;
+  int bound_n_ = 0;
+  double bound_pos_sum_ = 0.0, bound_att_sum_ = 0.0;
+  double at_bound_pos_sq_ = 0.0, at_bound_att_sq_ = 0.0;
 };
 
 std::string Seconds(int64_t t_ns) {
@@ -261,10 +283,10 @@ EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
                                     const EvaluationOptions& options,
                                     const EstimateReports& reports) {
   ValidateInputs(truth, estimate, options);
-  if ((!reports.covariances.empty() || !reports.decisions.empty()) &&
+  if ((!reports.covariances.empty() || !reports.decisions.empty() || !reports.bounds.empty()) &&
       options.alignment != Alignment::kNone) {
-    throw InputError("covariances and decisions are about the unaligned estimate: evaluate them "
-                     "without alignment");
+    throw InputError("covariances, decisions and bounds are about the unaligned estimate: "
+                     "evaluate them without alignment");
   }
   if (!(options.allowed_lateral_error_m > 0.0)) {
     throw InputError("allowed lateral error must be positive (got " +
@@ -272,6 +294,8 @@ EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
   }
   std::unordered_map<int64_t, const Eigen::Matrix<double, 6, 6>*> covariance_at;
   for (const StampedPoseCovariance& c : reports.covariances) covariance_at[c.t_ns] = &c.covariance;
+  std::unordered_map<int64_t, const Eigen::Matrix<double, 6, 6>*> bound_at;
+  for (const StampedPoseCovariance& b : reports.bounds) bound_at[b.t_ns] = &b.covariance;
 
   std::vector<VisibilityRecord> sorted_visibility;
   const std::vector<VisibilityRecord>* stages = &visibility;
@@ -302,6 +326,8 @@ EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
     m.stage = StageAt(*stages, pose.t_ns);
     const auto covariance = covariance_at.find(pose.t_ns);
     if (covariance != covariance_at.end()) m.covariance = covariance->second;
+    const auto bound = bound_at.find(pose.t_ns);
+    if (bound != bound_at.end()) m.bound = bound->second;
     matched.push_back(m);
   }
 
@@ -341,6 +367,10 @@ EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
       const double nees = PoseNees(m.T_est, m.T_true, *m.covariance);
       overall.AddNees(nees);
       per_stage[static_cast<int>(m.stage)].AddNees(nees);
+    }
+    if (m.bound != nullptr) {
+      overall.AddBound(m.T_est, m.T_true, *m.bound);
+      per_stage[static_cast<int>(m.stage)].AddBound(m.T_est, m.T_true, *m.bound);
     }
   }
   report.overall = overall.Stats();

@@ -360,6 +360,38 @@ TEST(EvaluateTrajectoryTest, NeesOfAKnownErrorAndItsCounts) {
   EXPECT_TRUE(std::isnan(plain.overall.nees_mean));
 }
 
+// A known bound at every third pose: its RMS, and the estimate's errors over those poses only.
+TEST(EvaluateTrajectoryTest, BoundRmsBesideTheErrorsOverTheSamePoses) {
+  const std::vector<GroundTruthState> truth = Truth();
+  Trajectory estimate = test::TrajectoryFromTruth(truth);
+  EstimateReports reports;
+  Eigen::Matrix<double, 6, 1> diagonal;
+  diagonal << 1e-4, 1e-4, 2e-4, 1e-6, 2e-6, 1e-6;  // tr P_p = 4e-4 m^2, tr P_theta = 4e-6 rad^2
+  for (size_t k = 0; k < estimate.size(); ++k) {
+    StampedPose& pose = estimate[k];
+    if (k % 3 == 0) {
+      pose.T_D_B.p.x() += 0.03;  // 3 cm off where there is a bound
+      pose.T_D_B.q = ExpQuaternion(Eigen::Vector3d(0.0, 0.0, 0.004)) * pose.T_D_B.q;
+      reports.bounds.push_back({pose.t_ns, Eigen::Matrix<double, 6, 6>(diagonal.asDiagonal())});
+    }
+  }
+  const EvaluationReport report =
+      EvaluateTrajectory(truth, estimate, {}, EvaluationOptions(), reports);
+  EXPECT_EQ(report.overall.bound_n, static_cast<int>(reports.bounds.size()));
+  EXPECT_NEAR(report.overall.bound_pos_rms_m, 0.02, 1e-12);
+  EXPECT_NEAR(report.overall.bound_att_rms_rad, 0.002, 1e-12);
+  EXPECT_NEAR(report.overall.pos_rmse_at_bound_m, 0.03, 1e-12);
+  EXPECT_NEAR(report.overall.att_rmse_at_bound_rad, 0.004, 1e-9);
+  EXPECT_NEAR(report.overall.pos_rmse_m, 0.03 / std::sqrt(3.0), 1e-3);  // all poses
+  // Without a bound the fields say "none"; with an alignment a bound is refused.
+  const EvaluationReport plain = EvaluateTrajectory(truth, estimate, {}, EvaluationOptions());
+  EXPECT_EQ(plain.overall.bound_n, 0);
+  EXPECT_TRUE(std::isnan(plain.overall.bound_pos_rms_m));
+  EvaluationOptions aligned;
+  aligned.alignment = Alignment::kSE3;
+  EXPECT_THROW(EvaluateTrajectory(truth, estimate, {}, aligned, reports), InputError);
+}
+
 // The audit with known errors: poses 0..9 are off by 0.06 m in x and 0.08 m in y (0.10 m
 // lateral, at the limit: safe), poses 10..19 by 0.12 m in x (unsafe), the rest exact. GO at
 // every even pose, one GO at a time with no pose, NO-GO elsewhere.

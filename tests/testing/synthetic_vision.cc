@@ -51,7 +51,9 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
   for (int64_t k = 0;; ++k) {
     const int64_t t = simulator.SampleTime(k, scenario.imu.rate_hz);
     if (simulator.Seconds(t) > scenario.duration_s) break;
-    run.imu.push_back(imu.Sample(t, simulator.trajectory().At(simulator.Seconds(t))));
+    const KinematicState state = simulator.trajectory().At(simulator.Seconds(t));
+    run.imu.push_back(imu.Sample(t, state));
+    run.states.push_back({t, state.T_D_B, state.v_D, imu.gyro_bias(), imu.accel_bias()});
   }
 
   DepthSimulator depth(scenario.depth, scenario.dock, true, MakeRandomStream(seed, 104));

@@ -25,6 +25,7 @@ struct SyntheticRun {
   std::vector<ImuSample> imu;
   std::vector<VisionFrame> frames;
   std::vector<StampedPose> truth;  // body pose at each frame
+  std::vector<GroundTruthState> states;  // the whole state (biases too) at every IMU sample
   std::vector<DepthMeasurement> depth;  // the scenario's depth sensor (sim/depth_simulator.h)
   std::vector<DvlMeasurement> dvl;      // the scenario's DVL, gross errors included
   std::vector<FaultRecord> dvl_faults;  // its faults (sim/dvl_simulator.h)

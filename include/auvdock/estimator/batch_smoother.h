@@ -52,6 +52,13 @@ namespace auvdock {
 
 struct BatchSmootherOptions {
   int max_iterations = 50;
+  // The Fisher information of the problem at the warm start instead of a solve: no iteration,
+  // no robust loss (every kept measurement with its full configured weight), the gates applied
+  // at the warm-start values. With the true states as the warm start, each pose's marginal
+  // covariance is its Cramér–Rao bound under the configured noise models (crlb_command.cc): a
+  // misidentified light or a sensor fault fails its gate at the truth and is left out, as the
+  // estimator would leave it out.
+  bool information_at_warm_start = false;
   // Called after every solver iteration with (iteration, cost); may be empty.
   std::function<void(int, double)> progress;
 };

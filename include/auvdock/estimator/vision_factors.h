@@ -21,9 +21,9 @@
 // (sigma_px^2 + correlated_pixel_variance) / sigma_px^2. The batch smoother uses it for the
 // time-correlated part of the detection errors (estimator/batch_smoother.h); the sliding window
 // leaves it at 0.
-// Each gets a Huber loss (threshold huber_sigmas on the whitened norm) scaled by the frame's
-// stage weight for its camera system (estimator/stage_weighting.h): the weight multiplies the
-// residual's information, which is the source paper's stage weighting inside the problem.
+// Each gets a Huber loss (threshold huber_sigmas on the whitened norm; none when +infinity)
+// scaled by the frame's stage weight for its camera system (estimator/stage_weighting.h): the
+// weight multiplies the residual's information, which is the source paper's stage weighting inside the problem.
 // Images later than the state (VisionFrame::mono_dt_ns, stereo_dt_ns > 0: cameras not
 // synchronised with each other) are attached to the state through the IMU's motion over dt
 // (TimeShiftedFactor, factors/time_shifted_factor.h: on the pose and the velocity blocks), so

@@ -44,6 +44,12 @@
 // lateral error exceeds options.allowed_lateral_error_m is an unsafe GO -- what the go/no-go
 // must never issue. A GO without an estimate pose or truth at its time is counted apart.
 //
+// Cramér–Rao bound (optional): for each matched pose with a bound P at exactly its timestamp,
+// tr P_p and tr P_theta (its position and attitude blocks) are the expected squared errors of
+// the best unbiased estimator; ErrorStats reports their RMS beside the estimate's own RMSE over
+// the same poses (a ratio near 1: the estimator is as good as the data allow; below 1: the data
+// are better than the configured noise models that the bound assumes).
+//
 // Stages: an estimate pose belongs to the stage of the last visibility record at or before its
 // time (kUnknown before the first record or with no records).
 #pragma once
@@ -86,6 +92,14 @@ struct ErrorStats {
   int nees_n = 0;               // poses with a covariance
   double nees_mean = 0.0;       // NaN when nees_n == 0
   double nees_above_95 = 0.0;   // fraction of NEES > kNees95; NaN when nees_n == 0
+  // With a Cramér–Rao bound (EstimateReports::bounds): over the poses that have one,
+  // sqrt(mean tr P_p) and sqrt(mean tr P_theta), the RMS errors that the best unbiased estimator
+  // would have, and pos_rmse_m / att_rmse_rad over the same poses. NaN when bound_n == 0.
+  int bound_n = 0;
+  double bound_pos_rms_m = 0.0;
+  double bound_att_rms_rad = 0.0;
+  double pos_rmse_at_bound_m = 0.0;
+  double att_rmse_at_bound_rad = 0.0;
 };
 
 // The 95 % point of the chi-square distribution with 6 degrees of freedom.
@@ -111,6 +125,9 @@ struct DecisionAudit {
 struct EstimateReports {
   std::vector<StampedPoseCovariance> covariances;
   std::vector<StampedDecision> decisions;
+  // The Cramér–Rao bound per pose (`auvdock crlb`, estimator/cramer_rao_bound.h), matched by
+  // exact timestamp like the covariances.
+  std::vector<StampedPoseCovariance> bounds;
 };
 
 struct EvaluationReport {
