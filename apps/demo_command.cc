@@ -2,13 +2,14 @@
 //
 // The README's first command ends here: simulate a scenario (by default the shipped default
 // one), run the paper's per-frame baseline (`frontend`), the causal window (`run`) and the batch
-// smoother (`smooth`) on it, evaluate all three against the ground truth, and print one table
-// side by side: position RMSE by visibility stage and overall, the largest error per axis, the
-// attitude RMSE, the mean NEES of the reported covariance, the go/no-go audit, and the wall time
-// as a multiple of real time. Each step is the subcommand itself, run again as a child process
+// smoother (`smooth`) on it, compute the Cramér–Rao bound of every pose (`crlb`), evaluate all
+// three against the ground truth and the bound, and print one table side by side: position
+// RMSE by visibility stage and overall, the largest error per axis, the attitude RMSE, the
+// bound's RMS over each estimator's poses and the RMSE's ratio to it, the mean NEES of the
+// reported covariance, the go/no-go audit, and the wall time as a multiple of real time. Each step is the subcommand itself, run again as a child process
 // (child_process.h), so the demo shows exactly what a user's own calls give.
 // Writes into DIR (must not exist or be empty): dataset/, frontend/, run/, smooth/ (each
-// subcommand's files), plots/ (evaluate --plots of run), evaluation.json (the three evaluations
+// subcommand's files), crlb.csv (the bound), plots/ (evaluate --plots of run), evaluation.json (the three evaluations
 // and the wall times) and demo.log (every step's standard error).
 #include <cmath>
 #include <csignal>
@@ -123,7 +124,7 @@ void RunDemo(const DemoOptions& options) {
   const fs::path out(options.out);
   const std::string log = (out / "demo.log").string();
   const std::string dataset = (out / "dataset").string();
-  DemoSteps steps(log, options.quiet, 8);
+  DemoSteps steps(log, options.quiet, 9);
 
   std::vector<std::string> simulate = {"simulate", "--scenario", scenario,
                                        "--out",    dataset,      "--quiet"};
@@ -155,10 +156,16 @@ void RunDemo(const DemoOptions& options) {
     e.wall_s =
         steps.Run(e.title, {e.name, "--dataset", dataset, "--out", folder, "--quiet"}).wall_s;
   }
+  // The bound is optional: without it the table leaves its rows empty.
+  const std::string bound = (out / "crlb.csv").string();
+  std::string bound_failed;
+  steps.Run("Cramer-Rao bound (crlb)",
+            {"crlb", "--dataset", dataset, "--out", bound, "--quiet"}, &bound_failed);
   for (Estimator& e : estimators) {
     const std::string folder = (out / e.folder).string();
     std::vector<std::string> args = {
         "evaluate", "--dataset", dataset, "--estimate", folder + "/" + e.trajectory, "--json"};
+    if (bound_failed.empty()) args.insert(args.end(), {"--bound", bound});
     if (e.has_covariance) {
       args.insert(args.end(), {"--covariance", folder + "/covariance.csv", "--decisions",
                                folder + "/decisions.csv"});
@@ -186,6 +193,8 @@ void RunDemo(const DemoOptions& options) {
   nlohmann::ordered_json record;
   record["scenario"] = scenario;
   record["data_duration_s"] = duration_s;
+  record["bound"] = bound_failed.empty() ? nlohmann::json(bound) : nlohmann::json(nullptr);
+  if (!bound_failed.empty()) record["no_bound"] = bound_failed;
   for (const Estimator& e : estimators) {
     record[e.name] = {{"wall_s", e.wall_s}, {"evaluation", e.evaluation}};
     if (e.evaluation.is_null()) record[e.name]["no_evaluation"] = e.why_none;
@@ -223,6 +232,18 @@ void RunDemo(const DemoOptions& options) {
   });
   row("attitude RMSE, all [mrad]",
       [&](const Estimator& e) { return Cell(1e3 * Get(e.evaluation, {"att_rmse_rad"}), "%.2f"); });
+  row("Cramer-Rao bound RMS [mm] / [mrad]", [&](const Estimator& e) {
+    return Cell(1e3 * Get(e.evaluation, {"bound_pos_rms_m"}), "%.1f") + " / " +
+           Cell(1e3 * Get(e.evaluation, {"bound_att_rms_rad"}), "%.2f");
+  });
+  row("RMSE / bound, position / attitude", [&](const Estimator& e) {
+    return Cell(Get(e.evaluation, {"pos_rmse_at_bound_m"}) / Get(e.evaluation, {"bound_pos_rms_m"}),
+                "%.2f") +
+           " / " +
+           Cell(Get(e.evaluation, {"att_rmse_at_bound_rad"}) /
+                    Get(e.evaluation, {"bound_att_rms_rad"}),
+                "%.2f");
+  });
   row("mean NEES (6 dof: 6 if honest)",
       [&](const Estimator& e) { return Cell(Get(e.evaluation, {"nees_mean"}), "%.2f"); });
   row("GO decisions (unsafe)", [&](const Estimator& e) {
@@ -240,6 +261,10 @@ void RunDemo(const DemoOptions& options) {
       std::printf("\n  %s: no evaluation: %s", e.name.c_str(), e.why_none.c_str());
     }
   }
+  if (!bound_failed.empty()) std::printf("\n  no Cramer-Rao bound: %s", bound_failed.c_str());
+  std::printf(
+      "\n  bound: the best any unbiased estimator could do with these measurements under the\n"
+      "  configured noise models (crlb); a ratio below 1: the data are better than configured.\n");
   std::printf(
       "\n  frontend: the paper's per-frame pipeline (no IMU, no covariance, no decision); run: "
       "causal,\n  as the vehicle would use it; smooth: the whole log at once. Plots of run: %s\n",

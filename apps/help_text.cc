@@ -122,10 +122,10 @@ std::string DetectHelp() {
 
 std::string DemoHelp() {
   return "\nNeeds: nothing but this binary (the shipped default scenario), or --scenario.\n"
-         "Runs simulate, then frontend, run and smooth on the result, evaluates the three and\n"
-         "prints them side by side. Writes into --out: dataset/, frontend/, run/, smooth/ (each\n"
-         "subcommand's own files), plots/ (run's), evaluation.json, demo.log (every step's\n"
-         "messages).\n"
+         "Runs simulate, then frontend, run, smooth and crlb on the result, evaluates the three\n"
+         "against the truth and the bound and prints them side by side. Writes into --out:\n"
+         "dataset/, frontend/, run/, smooth/ (each subcommand's own files), crlb.csv, plots/\n"
+         "(run's), evaluation.json, demo.log (every step's messages).\n"
          "Example: auvdock demo --out out/demo\n";
 }
 

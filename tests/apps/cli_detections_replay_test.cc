@@ -85,6 +85,53 @@ TEST_F(DetectionsReplayCli, RunAndSmoothReplayTheDetections) {
   }
 }
 
+// `crlb` bounds every frame's pose from the same detections; `evaluate --bound` sets the
+// smoother's errors beside it (same order of magnitude: the smoother is nearly efficient on
+// synthetic detections, whose faults the gates take out). Without ground truth, or with a folder
+// for --out, one line and exit 2, and no file left behind.
+TEST_F(DetectionsReplayCli, TheBoundOfEveryPoseBesideTheSmoothersErrors) {
+  const std::string bound = *tmp_ / "crlb.csv";
+  const auto r = test::RunAuvdock({"crlb", "--dataset", dataset_, "--detections",
+                                   dataset_ + "/detections.csv", "--out", bound, "--quiet"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("121 poses with a bound"));
+  const std::vector<StampedPoseCovariance> poses = ReadPoseCovarianceCsv(bound);
+  ASSERT_EQ(poses.size(), 121u);
+  for (const StampedPoseCovariance& p : poses) {
+    const double position = p.covariance.topLeftCorner<3, 3>().trace();
+    EXPECT_GT(position, 0.0);
+    EXPECT_LT(position, 0.5 * 0.5 * 3.0);  // within the first state's prior
+  }
+  const std::string smooth = *tmp_ / "crlb_smooth";
+  ASSERT_EQ(test::RunAuvdock({"smooth", "--dataset", dataset_, "--detections",
+                              dataset_ + "/detections.csv", "--out", smooth, "--quiet"})
+                .exit_status,
+            0);
+  const auto e = test::RunAuvdock({"evaluate", "--dataset", dataset_, "--estimate",
+                                   smooth + "/trajectory.tum", "--bound", bound, "--json"});
+  ASSERT_EQ(e.exit_status, 0) << e.err;
+  const nlohmann::json report = nlohmann::json::parse(e.out);
+  EXPECT_GE(report.at("bound_n").get<int>(), 110);
+  const double ratio =
+      report.at("pos_rmse_at_bound_m").get<double>() / report.at("bound_pos_rms_m").get<double>();
+  EXPECT_GT(ratio, 0.3);
+  EXPECT_LT(ratio, 3.0);
+
+  const fs::path no_truth = *tmp_ / "no_truth";
+  fs::copy(dataset_, no_truth, fs::copy_options::recursive);
+  fs::remove(no_truth / "groundtruth" / "data.csv");
+  const std::string none = *tmp_ / "crlb_none.csv";
+  for (const auto& [dataset, out] : std::vector<std::pair<std::string, std::string>>{
+           {no_truth.string(), none}, {dataset_, tmp_->path()}}) {
+    const auto bad = test::RunAuvdock({"crlb", "--dataset", dataset, "--detections",
+                                       dataset_ + "/detections.csv", "--out", out, "--quiet"});
+    EXPECT_EQ(bad.exit_status, 2) << bad.err;
+    EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
+  }
+  EXPECT_FALSE(fs::exists(none));
+  EXPECT_FALSE(fs::exists(none + ".partial"));
+}
+
 TEST_F(DetectionsReplayCli, ADatasetWithoutImagesPointsToTheDetections) {
   const auto r = test::RunAuvdock({"run", "--dataset", dataset_, "--out", *tmp_ / "no_images"});
   EXPECT_EQ(r.exit_status, 2);

@@ -179,7 +179,7 @@ TEST(Cli, UnknownWordsNameThemselvesAndTheClosestValidOne) {
 // tree's share/auvdock links to data/), which exists.
 TEST(Cli, EachSubcommandsHelpSaysWhatItNeedsAndWrites) {
   for (const char* sub :
-       {"simulate", "run", "smooth", "frontend", "evaluate", "pnp", "detect", "demo"}) {
+       {"simulate", "run", "smooth", "crlb", "frontend", "evaluate", "pnp", "detect", "demo"}) {
     const auto r = test::RunAuvdock({sub, "--help"});
     EXPECT_EQ(r.exit_status, 0) << sub;
     EXPECT_THAT(r.out,
@@ -230,15 +230,17 @@ TEST(Cli, DemoComparesTheThreeEstimators) {
   const auto r = test::RunAuvdock({"demo", "--scenario", scenario, "--out", out});
   ASSERT_EQ(r.exit_status, 0) << r.err;
   EXPECT_THAT(r.out, AllOf(HasSubstr("frontend"), HasSubstr("run"), HasSubstr("smooth"),
-                           HasSubstr("position RMSE, all [mm]"), HasSubstr("mean NEES")));
+                           HasSubstr("position RMSE, all [mm]"), HasSubstr("mean NEES"),
+                           HasSubstr("Cramer-Rao bound RMS")));
   for (const char* file : {"dataset/calibration.yaml", "frontend/per_frame.tum",
-                           "run/trajectory.tum", "smooth/covariance.csv", "evaluation.json",
-                           "demo.log"}) {
+                           "run/trajectory.tum", "smooth/covariance.csv", "crlb.csv",
+                           "evaluation.json", "demo.log"}) {
     EXPECT_TRUE(fs::exists(fs::path(out) / file)) << file;
   }
   const auto record = nlohmann::json::parse(test::ReadTextFile(out + "/evaluation.json"));
   EXPECT_LT(record.at("run").at("evaluation").at("pos_rmse_m").get<double>(), 0.1);
   EXPECT_GT(record.at("smooth").at("evaluation").at("nees_mean").get<double>(), 0.0);
+  EXPECT_GT(record.at("smooth").at("evaluation").at("bound_pos_rms_m").get<double>(), 0.0);
 
   const auto again = test::RunAuvdock({"demo", "--scenario", scenario, "--out", out});
   EXPECT_EQ(again.exit_status, 2);
