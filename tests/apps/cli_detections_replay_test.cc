@@ -186,6 +186,18 @@ TEST_F(DetectionsReplayCli, TheEstimateAlsoInEurocColumns) {
     EXPECT_LT(states[i].v_D.norm(), 3.0);  // a docking approach, not a blow-up
   }
   EXPECT_FALSE(fs::exists(*tmp_ / "run_out/estimate.csv")) << "only with --euroc-csv";
+  // As evo_traj euroc reads it (evo/tools/file_interface.py, read_euroc_csv_trajectory): '#'
+  // lines skipped, every other line exactly 17 comma-separated numbers, the time in ns.
+  std::ifstream in(out + "/estimate.csv");
+  size_t rows = 0;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind('#', 0) == 0) continue;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 16) << line;
+    EXPECT_NE(line.back(), ',') << line;
+    EXPECT_EQ(line.substr(0, line.find(',')), std::to_string(states[rows].t_ns));
+    ++rows;
+  }
+  EXPECT_EQ(rows, states.size());
 }
 
 int CountLines(const std::string& path) {

@@ -3,11 +3,13 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <random>
 #include <string>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -85,6 +87,47 @@ TEST_F(TumIoTest, WriteThenReadIsIdentity) {
   const std::string path = PathOf("traj.tum");
   WriteTumTrajectory(path, trajectory);
   ExpectSameTrajectory(trajectory, ReadTumTrajectory(path));
+}
+
+// The rows of `path` as evo's readers see them (evo/tools/file_interface.py:
+// read_tum_trajectory_file, read_euroc_csv_trajectory): lines starting with '#' are skipped, the
+// rest split at every single delimiter (csv.reader: two spaces make an empty field, a trailing
+// one a last empty field), and each field must convert to a float (numpy astype(float)).
+std::vector<std::vector<double>> ReadAsEvoDoes(const std::string& path, char delimiter) {
+  std::ifstream in(path);
+  std::vector<std::vector<double>> rows;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind('#', 0) == 0) continue;
+    std::vector<double> row;
+    size_t start = 0;
+    while (true) {
+      const size_t end = line.find(delimiter, start);
+      const std::string field = line.substr(start, end - start);
+      char* parsed_to = nullptr;
+      const double value = std::strtod(field.c_str(), &parsed_to);
+      EXPECT_TRUE(!field.empty() && *parsed_to == '\0') << path << ": field '" << field << "'";
+      row.push_back(value);
+      if (end == std::string::npos) break;
+      start = end + 1;
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST_F(TumIoTest, EvoReadsTheFileAsItIs) {
+  const Trajectory trajectory = RandomTrajectory(50, 3);
+  const std::string path = PathOf("traj.tum");
+  WriteTumTrajectory(path, trajectory);
+  const std::vector<std::vector<double>> rows = ReadAsEvoDoes(path, ' ');
+  ASSERT_EQ(rows.size(), trajectory.size());  // the header is a '#' line, no blank lines
+  for (size_t i = 0; i < rows.size(); ++i) {
+    ASSERT_EQ(rows[i].size(), 8u) << "row " << i;  // t x y z qx qy qz qw
+    EXPECT_NEAR(rows[i][0], 1e-9 * static_cast<double>(trajectory[i].t_ns), 1e-6);  // seconds
+    EXPECT_NEAR(rows[i][1], trajectory[i].T_D_B.p.x(), 1e-12);
+    EXPECT_NEAR(std::abs(rows[i][7]), std::abs(trajectory[i].T_D_B.q.w()), 1e-12);  // w last
+  }
 }
 
 TEST_F(TumIoTest, NegativeAndZeroTimesRoundTrip) {
