@@ -14,6 +14,7 @@
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
+#include "auvdock/estimator/chain_marginals.h"
 #include "auvdock/estimator/sensor_factors.h"
 #include "auvdock/estimator/imu_buffer.h"
 #include "auvdock/estimator/vision_factors.h"
@@ -304,20 +305,37 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   result.iterations = static_cast<int>(summary.iterations.size());
   result.converged = summary.termination_type == ceres::CONVERGENCE;
 
-  // Marginal covariance of every pose.
+  // Marginal covariance of every pose: by the chain's two sweeps (chain_marginals.h, linear in
+  // the number of states); by ceres::Covariance when the problem is not a chain, or when the
+  // sweeps find a segment rank-deficient: they work on H = J^T J, whose condition number is the
+  // square of J's, and a long stretch on the IMU alone can leave a legitimately small
+  // information at rounding level there; the QR of J decides.
+  std::vector<std::vector<double*>> chain;
+  for (const auto& s : states) chain.push_back({s->pose, s->velocity, s->bias});
+  std::optional<std::vector<std::optional<Eigen::MatrixXd>>> chain_marginals =
+      ChainMarginals(&problem, chain);
+  if (chain_marginals &&
+      std::any_of(chain_marginals->begin(), chain_marginals->end(),
+                  [](const std::optional<Eigen::MatrixXd>& m) { return !m.has_value(); })) {
+    chain_marginals.reset();
+  }
   ceres::Covariance::Options cov_options;
   cov_options.algorithm_type = ceres::SPARSE_QR;
   cov_options.num_threads = 1;
   ceres::Covariance covariance(cov_options);
-  std::vector<std::pair<const double*, const double*>> blocks;
-  for (const auto& s : states) blocks.emplace_back(s->pose, s->pose);
-  const bool covariance_ok = covariance.Compute(blocks, &problem);
+  bool covariance_ok = false;
+  if (!chain_marginals) {
+    std::vector<std::pair<const double*, const double*>> blocks;
+    for (const auto& s : states) blocks.emplace_back(s->pose, s->pose);
+    covariance_ok = covariance.Compute(blocks, &problem);
+  }
 
   int64_t last_vision = INT64_MIN;
   std::vector<int64_t> dvl_times;  // of the DVL samples kept, for the go/no-go's DVL age
   for (const SensorResidual& r : dvl_residuals) dvl_times.push_back(r.t_ns);
   std::sort(dvl_times.begin(), dvl_times.end());
-  for (const auto& s : states) {
+  for (size_t k = 0; k < states.size(); ++k) {
+    const auto& s = states[k];
     EstimatorOutput out;
     out.t_ns = s->t_ns;
     out.T_D_B = PoseFromBlock(s->pose);
@@ -333,7 +351,13 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
         dvl_after == dvl_times.begin()
             ? -1.0
             : 1e-9 * static_cast<double>(s->t_ns - *std::prev(dvl_after));
-    if (covariance_ok) {
+    if (chain_marginals) {
+      const std::optional<Eigen::MatrixXd>& marginal = (*chain_marginals)[k];
+      if (marginal) {
+        out.covariance = marginal->topLeftCorner<6, 6>();
+        out.covariance_ok = out.covariance.allFinite();
+      }
+    } else if (covariance_ok) {
       Eigen::Matrix<double, 6, 6, Eigen::RowMajor> cov;
       if (covariance.GetCovarianceMatrixInTangentSpace({s->pose}, cov.data()) && cov.allFinite()) {
         out.covariance = cov;

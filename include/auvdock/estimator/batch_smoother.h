@@ -8,9 +8,12 @@
 // factor when the IMU covers the interval; where it does not (an IMU gap, a reset of the run),
 // the trajectory splits into independent segments, each with the initial priors on its first
 // state. Vision residuals are gated after a first solve and the problem re-solved without them.
-// The marginal covariance of every pose comes from ceres::Covariance (SPARSE_QR, SuiteSparse),
-// in the PoseManifold tangent space; a rank-deficient problem reports no covariance rather than
-// a wrong one.
+// The marginal covariance of every pose comes from the chain's two sweeps over its block-
+// tridiagonal information (estimator/chain_marginals.h: linear in the log's length), or from
+// ceres::Covariance (SPARSE_QR, SuiteSparse: quadratic) if a factor ever joins states that are
+// not neighbours or the sweeps find a segment rank-deficient (they square J's condition number;
+// the QR of J decides); in the PoseManifold tangent space. A rank-deficient problem reports no
+// covariance rather than a wrong one.
 //
 // Time-correlated vision errors. The image pipeline's light centres are not white: besides the
 // frame-to-frame scatter (which the cameras' pixel_noise_px covers) they carry a slowly varying
