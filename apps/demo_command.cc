@@ -107,7 +107,7 @@ std::string Cell(double value, const char* format) {
 }
 
 void PrintRow(const std::string& label, const std::vector<std::string>& cells) {
-  std::printf("  %-34s", label.c_str());
+  std::printf("  %-38s", label.c_str());
   for (const std::string& c : cells) std::printf(" %16s", c.c_str());
   std::printf("\n");
 }
@@ -214,24 +214,41 @@ void RunDemo(const DemoOptions& options) {
   row("poses / frames", [&](const Estimator& e) {
     return Cell(Get(e.evaluation, {"n_poses"}), "%.0f") + " / " + std::to_string(frames);
   });
-  for (const auto& [key, label] : std::vector<std::pair<std::string, std::string>>{
-           {"stereo_only", "position RMSE, stereo only [mm]"},
-           {"both", "position RMSE, both [mm]"},
-           {"mono_only", "position RMSE, mono only [mm]"}}) {
-    row(label, [&](const Estimator& e) {
-      return Cell(1e3 * Get(e.evaluation, {"stages", key, "pos_rmse_m"}), "%.1f");
+  // Per visibility stage, then over all poses: position RMSE, its largest error per axis of D,
+  // attitude RMSE (geodesic) and the largest roll / pitch / yaw error.
+  const auto triple = [](const nlohmann::json& j, const std::vector<std::string>& path,
+                         const char* format) {
+    const nlohmann::json* node = &j;
+    for (const std::string& key : path) {
+      if (!node->is_object() || !node->contains(key)) return std::string("-");
+      node = &node->at(key);
+    }
+    if (!node->is_array() || node->size() != 3) return std::string("-");
+    return Cell(1e3 * (*node)[0].get<double>(), format) + "/" +
+           Cell(1e3 * (*node)[1].get<double>(), format) + "/" +
+           Cell(1e3 * (*node)[2].get<double>(), format);
+  };
+  for (const auto& [key, name] : std::vector<std::pair<std::string, std::string>>{
+           {"stereo_only", "stereo only"}, {"both", "both"}, {"mono_only", "mono only"},
+           {"", "all"}}) {
+    std::vector<std::string> path;
+    if (!key.empty()) path = {"stages", key};
+    const auto at = [&](const std::string& field) {
+      std::vector<std::string> p = path;
+      p.push_back(field);
+      return p;
+    };
+    row(name + ": position RMSE [mm]", [&](const Estimator& e) {
+      return Cell(1e3 * Get(e.evaluation, at("pos_rmse_m")), "%.1f");
     });
+    row(name + ": max |x|/|y|/|z| [mm]",
+        [&](const Estimator& e) { return triple(e.evaluation, at("pos_max_abs_m"), "%.0f"); });
+    row(name + ": attitude RMSE [mrad]", [&](const Estimator& e) {
+      return Cell(1e3 * Get(e.evaluation, at("att_rmse_rad")), "%.2f");
+    });
+    row(name + ": max roll/pitch/yaw [mrad]",
+        [&](const Estimator& e) { return triple(e.evaluation, at("att_max_abs_rad"), "%.1f"); });
   }
-  row("position RMSE, all [mm]",
-      [&](const Estimator& e) { return Cell(1e3 * Get(e.evaluation, {"pos_rmse_m"}), "%.1f"); });
-  row("max |error| x / y / z [mm]", [&](const Estimator& e) {
-    if (!e.evaluation.contains("pos_max_abs_m")) return std::string("-");
-    const auto& m = e.evaluation.at("pos_max_abs_m");
-    return Cell(1e3 * m[0].get<double>(), "%.0f") + "/" + Cell(1e3 * m[1].get<double>(), "%.0f") +
-           "/" + Cell(1e3 * m[2].get<double>(), "%.0f");
-  });
-  row("attitude RMSE, all [mrad]",
-      [&](const Estimator& e) { return Cell(1e3 * Get(e.evaluation, {"att_rmse_rad"}), "%.2f"); });
   row("Cramer-Rao bound RMS [mm] / [mrad]", [&](const Estimator& e) {
     return Cell(1e3 * Get(e.evaluation, {"bound_pos_rms_m"}), "%.1f") + " / " +
            Cell(1e3 * Get(e.evaluation, {"bound_att_rms_rad"}), "%.2f");

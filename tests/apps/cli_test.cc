@@ -230,7 +230,7 @@ TEST(Cli, DemoComparesTheThreeEstimators) {
   const auto r = test::RunAuvdock({"demo", "--scenario", scenario, "--out", out});
   ASSERT_EQ(r.exit_status, 0) << r.err;
   EXPECT_THAT(r.out, AllOf(HasSubstr("frontend"), HasSubstr("run"), HasSubstr("smooth"),
-                           HasSubstr("position RMSE, all [mm]"), HasSubstr("mean NEES"),
+                           HasSubstr("all: position RMSE [mm]"), HasSubstr("mean NEES"),
                            HasSubstr("Cramer-Rao bound RMS")));
   for (const char* file : {"dataset/calibration.yaml", "frontend/per_frame.tum",
                            "run/trajectory.tum", "smooth/covariance.csv", "crlb.csv",
