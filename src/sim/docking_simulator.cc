@@ -1,9 +1,12 @@
 #include "auvdock/sim/docking_simulator.h"
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
-#include <future>
+#include <exception>
 #include <limits>
 #include <optional>
+#include <thread>
 
 #include "auvdock/io/csv.h"
 #include "auvdock/io/dataset_writer.h"
@@ -74,7 +77,8 @@ std::string DistractorDetail(const RenderedDistractor& d) {
 }  // namespace
 
 SimulationSummary DockingSimulator::Run(const std::string& dir, const CancellationToken& cancel,
-                                        const std::function<void(double)>& progress) const {
+                                        const std::function<void(double)>& progress,
+                                        int render_workers) const {
   const Scenario& s = scenario_;
   const bool noisy = s.noise_enabled;
   const Eigen::Vector3d& g_D = s.dock.gravity_D;
@@ -86,11 +90,6 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
   DvlSimulator dvl(s.dvl, s.dvl_faults, noisy, MakeRandomStream(s.seed, RandomStreamId::kDvl));
   AcousticSimulator acoustic(s.acoustic, s.dock, s.acoustic_faults, noisy,
                              MakeRandomStream(s.seed, RandomStreamId::kAcoustic));
-  std::vector<std::mt19937_64> camera_rngs;
-  for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
-    camera_rngs.push_back(MakeRandomStream(
-        s.seed, static_cast<uint64_t>(RandomStreamId::kCameraBase) + static_cast<uint64_t>(i)));
-  }
   std::vector<SyntheticDetector> detectors;  // without images: each camera's front-end
   if (!s.cameras.render_images) {
     for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
@@ -151,65 +150,92 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
 
   const double frame_period_s = 1.0 / s.cameras.rate_hz;
   const int64_t mono_offset_ns = std::llround(s.cameras.mono_time_offset_s * 1e9);
-  for (int64_t k = 0; k < n_frames; ++k) {
-    cancel.ThrowIfCancelled();
+  const size_t n_cameras = calibration_.cameras.size();
+  // Each camera at its own exposure time (the mono camera may lag the stereo pair).
+  auto camera_time = [&](int64_t k, size_t i) {
     const int64_t t = SampleTime(k, s.cameras.rate_hz);
-    emit_until(t);
-    const VisibilityRecord visibility = VisibilityAt(t);
-    writer.AddVisibility(visibility);
-    summary.stage_duration_s[static_cast<int>(visibility.stage)] += frame_period_s;
-    const size_t n_cameras = calibration_.cameras.size();
-    std::vector<int64_t> t_cams(n_cameras);
-    std::vector<Pose3> T_D_Cs(n_cameras);
-    for (std::size_t i = 0; i < n_cameras; ++i) {
-      const auto& cam = calibration_.cameras[i];
-      // Each camera at its own exposure time (the mono camera may lag the stereo pair).
-      t_cams[i] = cam.role == CameraRole::kMono ? t + mono_offset_ns : t;
-      T_D_Cs[i] = trajectory_.At(Seconds(t_cams[i])).T_D_B * cam.T_B_C;
-    }
-    // The cameras' images at once (each from its own renderer and random stream, written to its
-    // own file: the output does not depend on the order), then their rows in calibration order.
-    std::vector<RenderResult> images(n_cameras);
+    return calibration_.cameras[i].role == CameraRole::kMono ? t + mono_offset_ns : t;
+  };
+  auto camera_pose = [&](int64_t k, size_t i) {
+    return trajectory_.At(Seconds(camera_time(k, i))).T_D_B * calibration_.cameras[i].T_B_C;
+  };
+  // The images are rendered a batch of frames at a time by up to one worker per processor, each
+  // image from its own random stream (MakeImageRandomStream) into its own file: the output is
+  // the same whatever the order and the number of threads. Then the frames' rows, truth and
+  // faults are written in time order.
+  const int workers = render_workers > 0
+                          ? render_workers
+                          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int64_t batch_frames = s.cameras.render_images ? 2 * workers : 1;
+  std::vector<RenderResult> images;
+  for (int64_t k0 = 0; k0 < n_frames; k0 += batch_frames) {
+    cancel.ThrowIfCancelled();
+    const int64_t k1 = std::min(n_frames, k0 + batch_frames);
     if (s.cameras.render_images) {
-      std::vector<std::future<void>> work;
-      for (std::size_t i = 1; i < n_cameras; ++i) {
-        work.push_back(std::async(std::launch::async, [&, i] {
-          images[i] = renderers_[i].Render(T_D_Cs[i], camera_rngs[i]);
-          writer.WriteImageFile(calibration_.cameras[i].name, t_cams[i], images[i].image);
-        }));
-      }
-      if (n_cameras > 0) {
-        images[0] = renderers_[0].Render(T_D_Cs[0], camera_rngs[0]);
-        writer.WriteImageFile(calibration_.cameras[0].name, t_cams[0], images[0].image);
-      }
-      for (auto& w : work) w.get();  // rethrows a camera's failure
-    }
-    for (std::size_t i = 0; i < n_cameras; ++i) {
-      const auto& cam = calibration_.cameras[i];
-      const int64_t t_cam = t_cams[i];
-      const Pose3& T_D_C = T_D_Cs[i];
-      std::vector<RenderedLight> lights;
-      if (s.cameras.render_images) {
-        const RenderResult& image = images[i];
-        writer.AddImageRow(cam.name, t_cam);
-        lights = image.lights;
-        for (const auto& d : image.distractors) {
-          record_fault(FaultRecord{t_cam, cam.name, d.kind, DistractorDetail(d)});
+      const int jobs = static_cast<int>((k1 - k0) * static_cast<int64_t>(n_cameras));
+      images.assign(jobs, RenderResult{});
+      std::vector<std::exception_ptr> failures(jobs);
+      std::atomic<int> next{0};
+      auto render = [&] {
+        for (int j = next++; j < jobs; j = next++) {
+          if (cancel.IsCancelled()) return;
+          const int64_t k = k0 + j / static_cast<int>(n_cameras);
+          const size_t i = static_cast<size_t>(j) % n_cameras;
+          try {
+            std::mt19937_64 rng =
+                MakeImageRandomStream(s.seed, i, static_cast<uint64_t>(k));
+            images[j] = renderers_[i].Render(camera_pose(k, i), rng);
+            writer.WriteImageFile(calibration_.cameras[i].name, camera_time(k, i),
+                                  images[j].image);
+          } catch (...) {
+            failures[j] = std::current_exception();
+          }
         }
-      } else {
-        lights = renderers_[i].VisibleLights(T_D_C);
-        std::vector<FaultRecord> faults;
-        writer.AddDetections(detectors[i].Detect(t_cam, lights, &faults));
-        for (const FaultRecord& f : faults) record_fault(f);
+      };
+      std::vector<std::thread> threads;
+      for (int w = 1; w < std::min(workers, jobs); ++w) threads.emplace_back(render);
+      render();
+      for (std::thread& thread : threads) thread.join();
+      cancel.ThrowIfCancelled();
+      for (const std::exception_ptr& failure : failures) {
+        if (failure) std::rethrow_exception(failure);  // the first image's failure, in order
       }
-      std::vector<LightTruth> truth;
-      for (const RenderedLight& light : lights) {
-        truth.push_back({light.light_id, light.uv, light.range_m, light.radius_px, light.peak});
-      }
-      writer.AddLightTruth(cam.name, t_cam, truth, cam.intrinsics.width(), cam.intrinsics.height());
     }
-    ++summary.n_camera_frames;
-    if (progress) progress(static_cast<double>(k + 1) / static_cast<double>(n_frames));
+    for (int64_t k = k0; k < k1; ++k) {
+      cancel.ThrowIfCancelled();
+      const int64_t t = SampleTime(k, s.cameras.rate_hz);
+      emit_until(t);
+      const VisibilityRecord visibility = VisibilityAt(t);
+      writer.AddVisibility(visibility);
+      summary.stage_duration_s[static_cast<int>(visibility.stage)] += frame_period_s;
+      for (std::size_t i = 0; i < n_cameras; ++i) {
+        const auto& cam = calibration_.cameras[i];
+        const int64_t t_cam = camera_time(k, i);
+        std::vector<RenderedLight> lights;
+        if (s.cameras.render_images) {
+          RenderResult& image = images[(k - k0) * static_cast<int64_t>(n_cameras) + i];
+          writer.AddImageRow(cam.name, t_cam);
+          lights = image.lights;
+          for (const auto& d : image.distractors) {
+            record_fault(FaultRecord{t_cam, cam.name, d.kind, DistractorDetail(d)});
+          }
+          image.image.release();
+        } else {
+          lights = renderers_[i].VisibleLights(camera_pose(k, i));
+          std::vector<FaultRecord> faults;
+          writer.AddDetections(detectors[i].Detect(t_cam, lights, &faults));
+          for (const FaultRecord& f : faults) record_fault(f);
+        }
+        std::vector<LightTruth> truth;
+        for (const RenderedLight& light : lights) {
+          truth.push_back({light.light_id, light.uv, light.range_m, light.radius_px, light.peak});
+        }
+        writer.AddLightTruth(cam.name, t_cam, truth, cam.intrinsics.width(),
+                             cam.intrinsics.height());
+      }
+      ++summary.n_camera_frames;
+      if (progress) progress(static_cast<double>(k + 1) / static_cast<double>(n_frames));
+    }
   }
   emit_until(std::numeric_limits<int64_t>::max());  // the tail after the last frame
   writer.Close();

@@ -2,6 +2,8 @@
 
 #include <filesystem>
 #include <map>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -41,6 +43,35 @@ TEST(DockingSimulator, SameSeedGivesByteIdenticalOutputAndOtherSeedsDiffer) {
   EXPECT_NE(a.at("imu0/data.csv"), c.at("imu0/data.csv"));
   EXPECT_NE(a.at("cam0/data/1700000000000000000.png"), c.at("cam0/data/1700000000000000000.png"));
   EXPECT_EQ(a.at("groundtruth.tum"), c.at("groundtruth.tum"));  // the trajectory is the scenario's
+}
+
+// Each image has its own random stream (seed, camera, frame): the output is the same whatever
+// the number of threads that render it (1, 2 or 5 workers: batches of 2, 4 or 10 frames, images
+// finished in different orders), and an image the same whatever was rendered before it (a 0.3 s
+// run's frames are the first frames of the 1 s run).
+TEST(DockingSimulator, TheOutputDoesNotDependOnTheRenderingThreads) {
+  test::TempDir tmp;
+  const Scenario scenario = test::ShortScenario(1.0);
+  std::vector<std::map<std::string, std::string>> runs;
+  for (const int workers : {1, 2, 5}) {
+    const std::string dir = tmp / ("workers_" + std::to_string(workers));
+    fs::create_directories(dir);
+    DockingSimulator(scenario).Run(dir, CancellationToken(), {}, workers);
+    runs.push_back(ReadTree(dir));
+  }
+  ASSERT_GT(runs[0].size(), 33u);
+  EXPECT_EQ(runs[0], runs[1]);
+  EXPECT_EQ(runs[0], runs[2]);
+  fs::create_directories(tmp / "short");
+  DockingSimulator(test::ShortScenario(0.3)).Run(tmp / "short", CancellationToken(), {}, 3);
+  int images = 0;
+  for (const auto& [path, bytes] : ReadTree(tmp / "short")) {
+    if (path.size() < 4 || path.compare(path.size() - 4, 4, ".png") != 0) continue;
+    ASSERT_TRUE(runs[0].count(path)) << path;
+    EXPECT_EQ(bytes, runs[0].at(path)) << path;
+    ++images;
+  }
+  EXPECT_EQ(images, 3 * 4);
 }
 
 // Each image at its camera's own time (here the mono camera 37 ms after the stereo pair), and

@@ -3,10 +3,11 @@
 //
 // Time base: sample k of a sensor at rate f is at start_time_ns + round(k 1e9 / f), for every
 // k with k / f <= duration_s. Ground truth is written at the IMU rate. Each sensor draws from
-// its own random stream (seed, sensor), so the same scenario and seed give byte-identical
-// output. Work is streamed in time order (one camera frame at a time), memory stays flat; the
-// cameras of a frame are rendered and their PNGs written on a thread each (the same bytes: each
-// camera has its own renderer, random stream and files).
+// its own random stream (seed, sensor), and each image its own (seed, camera, frame), so the
+// same scenario and seed give byte-identical output. Work is streamed in time order, memory
+// stays flat: the images of a batch of frames (two per processor) are rendered and their PNGs
+// written by one worker per processor, in any order (the same bytes: each image has its own
+// stream and file), then the batch's rows are written in time order.
 #pragma once
 
 #include <array>
@@ -55,9 +56,11 @@ class DockingSimulator {
   Pose3 CameraPose(const CameraCalibration& camera, int64_t t_ns) const;
 
   // Writes the dataset into `dir` (an existing, empty folder). progress(fraction) is called
-  // after every camera frame. Throws Cancelled when the token is cancelled.
+  // after every camera frame. Throws Cancelled when the token is cancelled. render_workers:
+  // threads that render images (0: one per processor); the output does not depend on it.
   SimulationSummary Run(const std::string& dir, const CancellationToken& cancel,
-                        const std::function<void(double)>& progress = {}) const;
+                        const std::function<void(double)>& progress = {},
+                        int render_workers = 0) const;
 
  private:
   Scenario scenario_;

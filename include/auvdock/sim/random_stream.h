@@ -20,7 +20,6 @@ enum class RandomStreamId : uint64_t {
   kDvl = 3,
   kAcoustic = 4,
   kLensBase = 50,         // + camera index: the randomised distortion
-  kCameraBase = 100,  // + camera index
   kRenderLookBase = 200,  // + camera index: the randomised look
   kSyntheticDetectionsBase = 300,  // + camera index: the synthetic front-end's errors
 };
@@ -28,6 +27,13 @@ enum class RandomStreamId : uint64_t {
 std::mt19937_64 MakeRandomStream(uint64_t seed, uint64_t stream_id);
 inline std::mt19937_64 MakeRandomStream(uint64_t seed, RandomStreamId id) {
   return MakeRandomStream(seed, static_cast<uint64_t>(id));
+}
+
+// The stream of one image: camera index `camera` (< 256), frame number `frame`. One stream per
+// image lets the images be rendered in any order, on any number of threads, and still be the
+// same for a seed (ids from 2^32 up: apart from the fixed ones above).
+inline std::mt19937_64 MakeImageRandomStream(uint64_t seed, uint64_t camera, uint64_t frame) {
+  return MakeRandomStream(seed, (uint64_t{1} << 32) + (frame << 8) + camera);
 }
 
 // Uniform in [0, 1) with 53 random bits.
