@@ -13,7 +13,6 @@
 #include <filesystem>
 #include <memory>
 
-#include "apps/cli_validators.h"
 #include "apps/commands.h"
 #include "apps/dataset_input.h"
 #include "apps/help_text.h"
@@ -35,9 +34,7 @@ struct CrlbOptions {
   std::string dock;  // --dock: replaces the dataset's dock.yaml
   std::string out;   // the bound, covariance.csv format
   std::string config;
-  std::string detector = "contrast";
-  double sync_tolerance_ms = -1.0;  // < 0: half the shortest frame interval
-  std::string detections;           // replay this detections.csv instead of the images
+  FrameSourceOptions frames;  // --detector, --sync-tolerance-ms, --detections
   bool quiet = false;
 };
 
@@ -70,8 +67,7 @@ void Crlb(const CrlbOptions& options) {
   }
   const DockModel& dock = RequireDock(dataset);
   if (fs::is_directory(options.out)) throw InputError(options.out + ": is a folder, not a file");
-  VisionFrameSource source(dataset, ParseDetectorKind(options.detector),
-                           SyncToleranceNs(options.sync_tolerance_ms), options.detections);
+  VisionFrameSource source(dataset, options.frames);
   const CancellationToken cancel = InstallSignalCancellation();
   const VisionFrameSource::Predictor truth = [&](int64_t t_ns) -> std::optional<Pose3> {
     const std::optional<StateRecord> s = TrueStateAt(dataset.groundtruth, t_ns, 0.1);
@@ -132,15 +128,8 @@ void AddCrlbCommand(CLI::App& root) {
   sub->add_option("--out", options->out, "The bound, one 6x6 covariance per pose (CSV file)")
       ->required();
   sub->add_option("--config", options->config, "Estimator options (YAML): the noise models");
-  sub->add_option("--detector", options->detector,
-                  "contrast (default: developed on our renders) or blob (real water)")
-      ->check(CLI::IsMember({"contrast", "blob"}));
-  sub->add_option("--sync-tolerance-ms", options->sync_tolerance_ms,
-                  "Images of different cameras this close in time share one state (default: half "
-                  "the shortest frame interval; 0: equal time stamps only)")
-      ->check(NonNegative("milliseconds"));
-  sub->add_option("--detections", options->detections,
-                  "The light detections to bound (detections.csv) instead of the images'");
+  AddFrameSourceOptions(sub, &options->frames,
+                        "The light detections to bound (detections.csv) instead of the images'");
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { Crlb(*options); });
 }

@@ -3,14 +3,15 @@
 // The README's first command ends here: simulate a scenario (by default the shipped default
 // one), run the paper's per-frame baseline (`frontend`), the causal window (`run`) and the batch
 // smoother (`smooth`) on it, compute the Cramér–Rao bound of every pose (`crlb`), evaluate all
-// three against the ground truth and the bound, and print one table side by side: position
-// RMSE by visibility stage and overall, the largest error per axis, the attitude RMSE, the
-// bound's RMS over each estimator's poses and the RMSE's ratio to it, the mean NEES of the
-// reported covariance, the go/no-go audit, and the wall time as a multiple of real time. Each step is the subcommand itself, run again as a child process
-// (child_process.h), so the demo shows exactly what a user's own calls give.
+// three against the ground truth and the bound, and print one table side by side: per
+// visibility stage and overall, the position and attitude RMSE and the largest error per axis;
+// the bound's RMS over each estimator's poses and the RMSE's ratio to it; the mean NEES of the
+// reported covariance; the go/no-go audit; and the wall time as a multiple of real time. Each
+// step is the subcommand itself, run again as a child process (child_process.h), so the demo
+// shows exactly what a user's own calls give.
 // Writes into DIR (must not exist or be empty): dataset/, frontend/, run/, smooth/ (each
-// subcommand's files), crlb.csv (the bound), plots/ (evaluate --plots of run), evaluation.json (the three evaluations
-// and the wall times) and demo.log (every step's standard error).
+// subcommand's files), crlb.csv (the bound), plots/ (evaluate --plots of run), evaluation.json
+// (the three evaluations and the wall times) and demo.log (every step's standard error).
 #include <cmath>
 #include <csignal>
 #include <cstdio>

@@ -71,9 +71,10 @@ std::string SmoothHelp() {
 }
 
 std::string CrlbHelp() {
-  return "\nNeeds: what smooth needs, and the ground truth (groundtruth/data.csv): the bound is the\n"
-         "batch problem's information at the true states, with the configured noise models\n"
-         "(--config), marginalised per pose. No estimator can do better on average.\n"
+  return "\nNeeds: what smooth needs, and the ground truth (groundtruth/data.csv): the bound is\n"
+         "the batch problem's information at the true states, with the configured noise\n"
+         "models (--config), marginalised per pose. No unbiased estimator does better on\n"
+         "average under those models.\n"
          "Writes --out FILE: the bound in the covariance.csv format (timestamp_ns + the 6x6\n"
          "covariance, row-major, dp_D (m), dtheta_D (rad)); evaluate --bound FILE sets an\n"
          "estimate's errors beside it.\n" +

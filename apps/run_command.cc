@@ -11,7 +11,6 @@
 #include <cstdio>
 #include <memory>
 
-#include "apps/cli_validators.h"
 #include "apps/commands.h"
 #include "apps/dataset_input.h"
 #include "apps/estimate_writer.h"
@@ -34,9 +33,7 @@ struct RunOptions {
   std::string config;
   bool quiet = false;
   bool euroc_csv = false;  // --euroc-csv: also estimate.csv (estimate_writer.h)
-  std::string detector = "contrast";
-  double sync_tolerance_ms = -1.0;  // < 0: half the shortest frame interval
-  std::string detections;           // replay this detections.csv instead of the images
+  FrameSourceOptions frames;  // --detector, --sync-tolerance-ms, --detections
 };
 
 using Clock = std::chrono::steady_clock;
@@ -48,8 +45,7 @@ void Run(const RunOptions& options) {
   std::vector<std::string> skipped_rows;
   const Dataset dataset = LoadDatasetWithDock(options.dataset, options.dock, &skipped_rows);
   if (!dataset.calibration.imu) throw InputError(options.dataset + ": calibration has no IMU");
-  VisionFrameSource source(dataset, ParseDetectorKind(options.detector),
-                           SyncToleranceNs(options.sync_tolerance_ms), options.detections);
+  VisionFrameSource source(dataset, options.frames);
   SlidingWindowEstimator estimator(dataset.calibration, RequireDock(dataset), config.estimator);
   GoNoGo go_no_go(config.go_no_go);
   EstimateWriter writer(options.out, options.euroc_csv);
@@ -131,16 +127,10 @@ void AddRunCommand(CLI::App& root) {
   AddDockOption(sub, &options->dock);
   sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
   sub->add_option("--config", options->config, "Estimator and go/no-go options (YAML)");
-  sub->add_option("--detector", options->detector,
-                  "contrast (default: developed on our renders) or blob (real water)")
-      ->check(CLI::IsMember({"contrast", "blob"}));
-  sub->add_option("--sync-tolerance-ms", options->sync_tolerance_ms,
-                  "Images of different cameras this close in time share one state (default: half "
-                  "the shortest frame interval; 0: equal time stamps only)")
-      ->check(NonNegative("milliseconds"));
-  sub->add_option("--detections", options->detections,
-                  "Replay these light detections (detections.csv: `simulate` with render_images "
-                  "false, `frontend`, or a detector of your own) instead of the images");
+  AddFrameSourceOptions(sub, &options->frames,
+                        "Replay these light detections (detections.csv: `simulate` with "
+                        "render_images false, `frontend`, or a detector of your own) instead of "
+                        "the images");
   sub->add_flag("--euroc-csv", options->euroc_csv,
                 "Also write estimate.csv: the state in EuRoC's ground-truth columns (timestamp, "
                 "p, q w x y z, v, gyro bias, accelerometer bias), the format of evo_traj euroc");

@@ -1,6 +1,7 @@
 #include "apps/vision_frame_source.h"
 
 #include "apps/camera_image.h"
+#include "apps/cli_validators.h"
 #include "apps/dataset_input.h"
 
 #include <algorithm>
@@ -88,6 +89,22 @@ int64_t SyncToleranceNs(double milliseconds) {
   }
   return milliseconds < 0.0 ? -1 : std::llround(milliseconds * 1e6);
 }
+
+void AddFrameSourceOptions(CLI::App* sub, FrameSourceOptions* options,
+                           const std::string& detections_help) {
+  sub->add_option("--detector", options->detector,
+                  "contrast (default: developed on our renders) or blob (real water)")
+      ->check(CLI::IsMember({"contrast", "blob"}));
+  sub->add_option("--sync-tolerance-ms", options->sync_tolerance_ms,
+                  "Images of different cameras this close in time share one state (default: half "
+                  "the shortest frame interval; 0: equal time stamps only)")
+      ->check(NonNegative("milliseconds"));
+  sub->add_option("--detections", options->detections, detections_help);
+}
+
+VisionFrameSource::VisionFrameSource(const Dataset& dataset, const FrameSourceOptions& options)
+    : VisionFrameSource(dataset, ParseDetectorKind(options.detector),
+                        SyncToleranceNs(options.sync_tolerance_ms), options.detections) {}
 
 VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind detector,
                                      int64_t sync_tolerance_ns, const std::string& detections_path)

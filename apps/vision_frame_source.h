@@ -29,6 +29,8 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "apps/image_prefetcher.h"
 #include "auvdock/estimator/vision_frame.h"
 #include "auvdock/io/dataset.h"
@@ -42,6 +44,16 @@ LightDetectorKind ParseDetectorKind(const std::string& name);
 // The --sync-tolerance-ms option in ns: < 0 (the default) stays < 0; NaN/Inf throw InputError.
 int64_t SyncToleranceNs(double milliseconds);
 
+// The command-line options that choose the frames of `run`, `smooth` and `crlb`.
+struct FrameSourceOptions {
+  std::string detector = "contrast";  // --detector
+  double sync_tolerance_ms = -1.0;    // --sync-tolerance-ms; < 0: half the shortest interval
+  std::string detections;             // --detections: replay this file instead of the images
+};
+// Registers --detector, --sync-tolerance-ms and --detections (described by detections_help).
+void AddFrameSourceOptions(CLI::App* sub, FrameSourceOptions* options,
+                           const std::string& detections_help);
+
 class VisionFrameSource {
  public:
   // Throws InputError when the dataset has no dock or no camera frames (or detections_path,
@@ -52,6 +64,8 @@ class VisionFrameSource {
                              LightDetectorKind detector = LightDetectorKind::kContrast,
                              int64_t sync_tolerance_ns = -1,
                              const std::string& detections_path = "");
+  // The same, from the command line's options.
+  VisionFrameSource(const Dataset& dataset, const FrameSourceOptions& options);
   VisionFrameSource(const VisionFrameSource&) = delete;  // its decoder refers to it
   VisionFrameSource& operator=(const VisionFrameSource&) = delete;
 
