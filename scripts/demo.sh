@@ -2,9 +2,9 @@
 # The README's first command: install what is missing, build, and run the main job on the
 # built-in default scenario (`auvdock demo`): simulate it, run the paper's per-frame baseline, the
 # causal sliding-window estimator (trajectory, covariance, go/no-go decisions) and the batch
-# smoother on it, evaluate the three against the ground truth (accuracy by visibility stage,
-# covariance consistency (NEES), the go/no-go audit) and print them side by side, with plots in
-# out/demo/plots/.
+# smoother on it, compute the Cramér-Rao bound of every pose, evaluate the three against the
+# ground truth and the bound (accuracy by visibility stage, covariance consistency (NEES), the
+# go/no-go audit) and print them side by side, with plots in out/demo/plots/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install_deps.sh
@@ -15,5 +15,6 @@ cmake --build build -j"$(nproc)" --target auvdock_cli
 out=out/demo
 rm -rf "$out"   # the demo's own folder from a previous demo run
 # simulate, frontend (the paper's per-frame baseline), run (the causal window), smooth (the batch
-# smoother), each evaluated; one table side by side; plots of run in out/demo/plots/.
+# smoother), crlb (the bound), each evaluated; one table side by side; plots of run in
+# out/demo/plots/.
 build/bin/auvdock demo --out "$out"
