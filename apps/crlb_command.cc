@@ -20,6 +20,7 @@
 #include "apps/vision_frame_source.h"
 #include "auvdock/estimator/cramer_rao_bound.h"
 #include "auvdock/estimator/estimator_config.h"
+#include "auvdock/eval/truth_interpolation.h"
 #include "auvdock/io/csv.h"
 #include "auvdock/io/dataset.h"
 #include "auvdock/io/input_error.h"
@@ -70,9 +71,11 @@ void Crlb(const CrlbOptions& options) {
   VisionFrameSource source(dataset, options.frames);
   const CancellationToken cancel = InstallSignalCancellation();
   const VisionFrameSource::Predictor truth = [&](int64_t t_ns) -> std::optional<Pose3> {
-    const std::optional<StateRecord> s = TrueStateAt(dataset.groundtruth, t_ns, 0.1);
-    if (!s) return std::nullopt;
-    return PoseFromBlock(s->pose);
+    GroundTruthState s;
+    if (InterpolateTruth(dataset.groundtruth, t_ns, 0.1, &s) != TruthLookup::kFound) {
+      return std::nullopt;
+    }
+    return s.T_D_B;
   };
   std::vector<VisionFrame> frames;
   while (std::optional<VisionFrame> frame = source.Next(truth)) {

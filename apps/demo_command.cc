@@ -90,14 +90,20 @@ nlohmann::json ParseEvaluation(const ChildResult& result, const std::string& wha
   }
 }
 
-// A number from an evaluation, or NaN when absent.
-double Get(const nlohmann::json& j, const std::vector<std::string>& path) {
+// The node at `path` in an evaluation, or nullptr when absent.
+const nlohmann::json* Find(const nlohmann::json& j, const std::vector<std::string>& path) {
   const nlohmann::json* node = &j;
   for (const std::string& key : path) {
-    if (!node->is_object() || !node->contains(key)) return std::nan("");
+    if (!node->is_object() || !node->contains(key)) return nullptr;
     node = &node->at(key);
   }
-  return node->is_number() ? node->get<double>() : std::nan("");
+  return node;
+}
+
+// A number from an evaluation, or NaN when absent.
+double Get(const nlohmann::json& j, const std::vector<std::string>& path) {
+  const nlohmann::json* node = Find(j, path);
+  return node != nullptr && node->is_number() ? node->get<double>() : std::nan("");
 }
 
 std::string Cell(double value, const char* format) {
@@ -219,12 +225,8 @@ void RunDemo(const DemoOptions& options) {
   // attitude RMSE (geodesic) and the largest roll / pitch / yaw error.
   const auto triple = [](const nlohmann::json& j, const std::vector<std::string>& path,
                          const char* format) {
-    const nlohmann::json* node = &j;
-    for (const std::string& key : path) {
-      if (!node->is_object() || !node->contains(key)) return std::string("-");
-      node = &node->at(key);
-    }
-    if (!node->is_array() || node->size() != 3) return std::string("-");
+    const nlohmann::json* node = Find(j, path);
+    if (node == nullptr || !node->is_array() || node->size() != 3) return std::string("-");
     return Cell(1e3 * (*node)[0].get<double>(), format) + "/" +
            Cell(1e3 * (*node)[1].get<double>(), format) + "/" +
            Cell(1e3 * (*node)[2].get<double>(), format);

@@ -4,7 +4,6 @@
 #include <cstdlib>
 #include <stdexcept>
 
-#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
 #include <ceres/crs_matrix.h>

@@ -10,6 +10,7 @@
 #include <unordered_map>
 
 #include "auvdock/eval/trajectory_alignment.h"
+#include "auvdock/eval/truth_interpolation.h"
 #include "auvdock/geometry/so3.h"
 #include "auvdock/io/input_error.h"
 
@@ -148,31 +149,6 @@ void ValidateInputs(const std::vector<GroundTruthState>& truth, const Trajectory
                        " (t = " + Seconds(estimate[i].t_ns) + " s)");
     }
   }
-}
-
-enum class TruthLookup { kFound, kOutsideSpan, kInGap };
-
-// The true pose at t_ns: the sample itself, or the interpolation between the samples around it.
-TruthLookup InterpolateTruth(const std::vector<GroundTruthState>& truth, int64_t t_ns,
-                             double max_gap_s, Pose3* T_true) {
-  const auto after =
-      std::lower_bound(truth.begin(), truth.end(), t_ns,
-                       [](const GroundTruthState& s, int64_t t) { return s.t_ns < t; });
-  if (after == truth.end()) return TruthLookup::kOutsideSpan;
-  if (after->t_ns == t_ns) {
-    *T_true = after->T_D_B;
-    return TruthLookup::kFound;
-  }
-  if (after == truth.begin()) return TruthLookup::kOutsideSpan;
-  const GroundTruthState& a = *(after - 1);
-  const GroundTruthState& b = *after;
-  const int64_t gap_ns = b.t_ns - a.t_ns;
-  // Compared in nanoseconds: 0.1 * 1e9 rounds to exactly 1e8 while 1e8 * 1e-9 may exceed 0.1,
-  // so a 10 Hz truth is not in a gap with max_gap_s = 0.1.
-  if (static_cast<double>(gap_ns) > max_gap_s * 1e9) return TruthLookup::kInGap;
-  const double alpha = static_cast<double>(t_ns - a.t_ns) / static_cast<double>(gap_ns);
-  *T_true = Interpolate(a.T_D_B, b.T_D_B, alpha);
-  return TruthLookup::kFound;
 }
 
 // `visibility` sorted by time. The stage of the last record at or before t_ns.
@@ -314,14 +290,16 @@ EvaluationReport EvaluateTrajectory(const std::vector<GroundTruthState>& truth,
   int n_in_gap = 0;
   for (const StampedPose& pose : estimate) {
     MatchedPose m;
+    GroundTruthState true_state;
     const TruthLookup lookup =
-        InterpolateTruth(truth, pose.t_ns, options.max_truth_gap_s, &m.T_true);
+        InterpolateTruth(truth, pose.t_ns, options.max_truth_gap_s, &true_state);
     if (lookup != TruthLookup::kFound) {
       ++report.n_skipped;
       if (lookup == TruthLookup::kInGap) ++n_in_gap;
       continue;
     }
     m.t_ns = pose.t_ns;
+    m.T_true = true_state.T_D_B;
     m.T_est = pose.T_D_B;
     m.stage = StageAt(*stages, pose.t_ns);
     const auto covariance = covariance_at.find(pose.t_ns);

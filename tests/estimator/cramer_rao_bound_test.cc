@@ -70,12 +70,7 @@ TEST(CramerRaoBoundTest, IsTheSmoothersInformationAtTheTruth) {
   EstimatorOptions white;  // the data are white: no allowance for correlated pixel errors
   white.smoother_vision_floor_px = 0.0;
   SlidingWindowEstimator estimator(run.calibration, run.dock, white);
-  for (size_t k = 0, next_imu = 0; k < run.frames.size(); ++k) {
-    while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= run.frames[k].t_ns) {
-      estimator.AddImu(run.imu[next_imu++]);
-    }
-    estimator.AddVisionFrame(run.frames[k]);
-  }
+  test::RunWindow(run, &estimator);
   const BatchResult batch = SmoothBatch(run.calibration, run.dock, run.frames, run.imu,
                                         estimator.History(), white);
   const CramerRaoBound bound =

@@ -35,12 +35,7 @@ TEST(CramerRaoConsistencyTest, TheSmoothersErrorsAttainTheBound) {
   for (uint64_t seed = 1; seed <= kRuns; ++seed) {
     const test::SyntheticRun run = test::MakeSyntheticRun(test::DefaultScenario(), seed);
     SlidingWindowEstimator estimator(run.calibration, run.dock, white);
-    for (size_t k = 0, next_imu = 0; k < run.frames.size(); ++k) {
-      while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= run.frames[k].t_ns) {
-        estimator.AddImu(run.imu[next_imu++]);
-      }
-      estimator.AddVisionFrame(run.frames[k]);
-    }
+    test::RunWindow(run, &estimator);
     const BatchResult batch = SmoothBatch(run.calibration, run.dock, run.frames, run.imu,
                                           estimator.History(), white);
     const CramerRaoBound bound =

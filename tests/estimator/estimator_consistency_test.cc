@@ -90,29 +90,6 @@ class NeesTally {
   std::map<size_t, std::vector<double>> by_frame_;
 };
 
-// Runs the sliding window over a run, frame by frame; returns the outputs by frame index.
-// with_sensors: the run's depth and DVL samples too.
-std::map<size_t, EstimatorOutput> RunWindow(const test::SyntheticRun& run,
-                                            SlidingWindowEstimator* estimator,
-                                            bool with_sensors = false) {
-  std::map<size_t, EstimatorOutput> outputs;
-  size_t next_imu = 0, next_depth = 0, next_dvl = 0;
-  for (size_t k = 0; k < run.frames.size(); ++k) {
-    const int64_t t = run.frames[k].t_ns;
-    while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= t) {
-      estimator->AddImu(run.imu[next_imu++]);
-    }
-    while (with_sensors && next_depth < run.depth.size() && run.depth[next_depth].t_ns <= t) {
-      estimator->AddDepth(run.depth[next_depth++]);
-    }
-    while (with_sensors && next_dvl < run.dvl.size() && run.dvl[next_dvl].t_ns <= t) {
-      estimator->AddDvl(run.dvl[next_dvl++]);
-    }
-    if (auto out = estimator->AddVisionFrame(run.frames[k])) outputs[k] = *out;
-  }
-  return outputs;
-}
-
 TEST(EstimatorConsistencyTest, SlidingWindowAneesOverTwentyRunsIsInTheChiSquareBand) {
   const Scenario scenario = test::DefaultScenario();
   constexpr int kRuns = 20;
@@ -123,7 +100,7 @@ TEST(EstimatorConsistencyTest, SlidingWindowAneesOverTwentyRunsIsInTheChiSquareB
   for (uint64_t seed = 1; seed <= kRuns; ++seed) {
     const test::SyntheticRun run = test::MakeSyntheticRun(scenario, seed);
     SlidingWindowEstimator estimator(run.calibration, run.dock, white);
-    for (const auto& [k, out] : RunWindow(run, &estimator)) tally.Add(run, k, out);
+    for (const auto& [k, out] : test::RunWindow(run, &estimator)) tally.Add(run, k, out);
   }
   tally.Check(kRuns, 0.85, "sliding window");
 }
@@ -139,7 +116,7 @@ TEST(EstimatorConsistencyTest, SmootherAneesOverTwentyRunsIsInTheChiSquareBand) 
   for (uint64_t seed = 1; seed <= kRuns; ++seed) {
     const test::SyntheticRun run = test::MakeSyntheticRun(scenario, seed);
     SlidingWindowEstimator estimator(run.calibration, run.dock);
-    RunWindow(run, &estimator);
+    test::RunWindow(run, &estimator);
     const BatchResult batch = SmoothBatch(run.calibration, run.dock, run.frames, run.imu,
                                           estimator.History(), white);
     std::map<int64_t, size_t> frame_at;  // a run may start a few frames late
@@ -173,7 +150,7 @@ double WindowMeanNees(const test::SyntheticPixelNoise& noise, const EstimatorOpt
   for (uint64_t seed = 1; seed <= static_cast<uint64_t>(num_seeds); ++seed) {
     const test::SyntheticRun run = test::MakeSyntheticRun(scenario, seed, noise);
     SlidingWindowEstimator estimator(run.calibration, run.dock, options);
-    for (const auto& [k, out] : RunWindow(run, &estimator)) {
+    for (const auto& [k, out] : test::RunWindow(run, &estimator)) {
       if (const auto nees = CountedNees(run, k, out)) {
         sum += *nees;
         ++count;
@@ -294,7 +271,7 @@ TEST(EstimatorConsistencyTest, ADvlThreeTimesNoisierThanConfiguredIsHonestWithAd
       EstimatorOptions options = white;
       options.adaptive_dvl_noise.enabled = adapt;
       SlidingWindowEstimator estimator(run.calibration, run.dock, options);
-      for (const auto& [k, out] : RunWindow(run, &estimator, /*with_sensors=*/true)) {
+      for (const auto& [k, out] : test::RunWindow(run, &estimator, /*with_sensors=*/true)) {
         if (run.frames[k].t_ns >= t_dark + 500'000'000) {
           (adapt ? adaptive : fixed).Add(run, k, out, /*lit_only=*/false);
         }

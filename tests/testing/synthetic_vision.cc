@@ -132,4 +132,25 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
   return run;
 }
 
+std::map<size_t, EstimatorOutput> RunWindow(const SyntheticRun& run,
+                                            SlidingWindowEstimator* estimator,
+                                            bool with_sensors) {
+  std::map<size_t, EstimatorOutput> outputs;
+  size_t next_imu = 0, next_depth = 0, next_dvl = 0;
+  for (size_t k = 0; k < run.frames.size(); ++k) {
+    const int64_t t = run.frames[k].t_ns;
+    while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= t) {
+      estimator->AddImu(run.imu[next_imu++]);
+    }
+    while (with_sensors && next_depth < run.depth.size() && run.depth[next_depth].t_ns <= t) {
+      estimator->AddDepth(run.depth[next_depth++]);
+    }
+    while (with_sensors && next_dvl < run.dvl.size() && run.dvl[next_dvl].t_ns <= t) {
+      estimator->AddDvl(run.dvl[next_dvl++]);
+    }
+    if (auto out = estimator->AddVisionFrame(run.frames[k])) outputs[k] = *out;
+  }
+  return outputs;
+}
+
 }  // namespace auvdock::test

@@ -8,9 +8,12 @@
 // (VisionFrame::mono_dt_ns); the frame, the truth and the stereo points stay at the pair's time.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <map>
 #include <vector>
 
+#include "auvdock/estimator/sliding_window_estimator.h"
 #include "auvdock/estimator/vision_frame.h"
 #include "auvdock/geometry/stamped_pose.h"
 #include "auvdock/io/calibration.h"
@@ -45,5 +48,11 @@ struct SyntheticPixelNoise {
 };
 SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
                               const SyntheticPixelNoise& noise);
+
+// Runs the sliding window over a run, frame by frame, feeding the IMU samples up to each frame
+// (with_sensors: the depth and DVL samples too); returns the outputs by frame index.
+std::map<size_t, EstimatorOutput> RunWindow(const SyntheticRun& run,
+                                            SlidingWindowEstimator* estimator,
+                                            bool with_sensors = false);
 
 }  // namespace auvdock::test

@@ -32,9 +32,9 @@
 
 namespace auvdock {
 
-// The true state at t_ns interpolated between the two truth samples around it (the sample
-// itself when t_ns falls on one); nothing outside the truth's span or between two samples more
-// than max_gap_s apart. `truth` in strictly increasing time.
+// The true state at t_ns in the blocks' layout (eval/truth_interpolation.h); nothing outside the
+// truth's span or between two samples more than max_gap_s apart. `truth` in strictly increasing
+// time.
 std::optional<StateRecord> TrueStateAt(const std::vector<GroundTruthState>& truth, int64_t t_ns,
                                        double max_gap_s);
 
