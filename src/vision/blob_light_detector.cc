@@ -24,7 +24,11 @@ BlobLightDetector::BlobLightDetector(const BlobLightDetectorOptions& options) : 
       !(options.border_sigma_fraction >= 0.0) || options.max_detections < 1 ||
       !(options.halo_extent_sigmas >= 0.0) || !(options.max_response_in_halo >= 0.0) ||
       !(options.checks.halo_radius_sigmas > 0.0) || !(options.checks.max_core_elongation >= 1.0) ||
-      !(options.checks.max_core_stretch_px >= 0.0) || !(options.close_light_min_sigma_px > 0.0)) {
+      !(options.checks.max_core_stretch_px >= 0.0) || !(options.close_light_min_sigma_px > 0.0) ||
+      !(options.checks.surroundings_halo_radii >= 0.0) ||
+      !(options.checks.surroundings_quantile >= 0.0 && options.checks.surroundings_quantile <= 1.0) ||
+      !(options.checks.min_own_colour_fraction >= 0.0 &&
+        options.checks.min_own_colour_fraction <= 1.0)) {
     throw std::invalid_argument("BlobLightDetectorOptions out of range");
   }
   FindBlobCandidates(cv::Mat::zeros(16, 16, CV_32F), options.candidates);  // checks its options

@@ -14,6 +14,28 @@ constexpr int kHaloRings = 3;
 constexpr int kSectors = 8;
 constexpr double kPi = 3.14159265358979323846;
 
+constexpr double kMinSurroundingsGapPx = 6.0;
+
+// The quantile of the colour excess on a ring of kRingSamples points (those inside the image);
+// -infinity when the whole ring is outside.
+double SurroundingsExcess(const cv::Mat& bgr, const Eigen::Vector2d& centre, double radius,
+                          LightColour colour, double quantile) {
+  std::vector<double> excess;
+  excess.reserve(kRingSamples);
+  for (int s = 0; s < kRingSamples; ++s) {
+    const double angle = 2.0 * kPi * s / kRingSamples;
+    const int px = static_cast<int>(std::lround(centre.x() + radius * std::cos(angle)));
+    const int py = static_cast<int>(std::lround(centre.y() + radius * std::sin(angle)));
+    if (px < 0 || py < 0 || px >= bgr.cols || py >= bgr.rows) continue;
+    const cv::Vec3b& p = bgr.at<cv::Vec3b>(py, px);
+    excess.push_back(ColourExcess(colour, p[0], p[1], p[2]));
+  }
+  if (excess.empty()) return -std::numeric_limits<double>::infinity();
+  const size_t k = static_cast<size_t>(quantile * (excess.size() - 1));
+  std::nth_element(excess.begin(), excess.begin() + k, excess.end());
+  return excess[k];
+}
+
 }  // namespace
 
 LightCandidateEvidence MeasureCandidateEvidence(const cv::Mat& bgr, const cv::Mat& luma,
@@ -26,6 +48,13 @@ LightCandidateEvidence MeasureCandidateEvidence(const cv::Mat& bgr, const cv::Ma
   // The peak test on the outer ring; the colour on rings from just outside the core to it (a
   // halo's colour is strongest next to the white core, and fades into the background).
   evidence.halo_excess = -std::numeric_limits<double>::infinity();
+  if (colour_image && options.surroundings_halo_radii > 0.0) {
+    const double radius =
+        std::max(options.surroundings_halo_radii * outer, outer + kMinSurroundingsGapPx);
+    evidence.surroundings_excess =
+        SurroundingsExcess(bgr, core.uv, radius, options.colour, options.surroundings_quantile) -
+        background_excess;
+  }
   const double inner = std::min(outer, std::max(core.radius_px + 1.0, 0.5 * outer));
   for (int ring = 0; ring < kHaloRings; ++ring) {
     const double rho = inner + (outer - inner) * ring / (kHaloRings - 1.0);
@@ -149,8 +178,15 @@ std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore&
       evidence.flatness > options.max_flatness) {
     return "flat top (a lit surface)";
   }
-  if (has_colour && options.colour != LightColour::kWhite &&
-      evidence.halo_excess < options.min_halo_excess) {
+  const bool colour_test = has_colour && options.colour != LightColour::kWhite;
+  if (colour_test && options.surroundings_halo_radii > 0.0 && evidence.halo_excess > 0.0 &&
+      evidence.halo_excess - evidence.surroundings_excess <
+          options.min_own_colour_fraction * evidence.halo_excess) {
+    return "the colour of its surroundings (halo excess " +
+           std::to_string(std::lround(evidence.halo_excess)) + ", surroundings " +
+           std::to_string(std::lround(evidence.surroundings_excess)) + ")";
+  }
+  if (colour_test && evidence.halo_excess < options.min_halo_excess) {
     return "wrong colour (halo excess " + std::to_string(std::lround(evidence.halo_excess)) +
            "; need " + std::to_string(std::lround(options.min_halo_excess)) + ")";
   }

@@ -173,6 +173,46 @@ TEST(BlobLightDetector, TheColourCheckIsWhatRejectsWhiteClutter) {
   EXPECT_GT(as_white.size(), as_blue.size());
 }
 
+// Marine snow in water of the lights' own colour, in an image mostly of a pale deck: the halo
+// of a speck is as blue as the water round it, far above the image's median. Only against its
+// surroundings is it no light; a LED in the same water still is.
+TEST(BlobLightDetector, SpecksInWaterOfTheLightsColourAreNotLights) {
+  cv::Mat image(480, 640, CV_32FC3);
+  for (int y = 0; y < image.rows; ++y) {
+    for (int x = 0; x < image.cols; ++x) {
+      image.at<cv::Vec3f>(y, x) =
+          x < 400 ? cv::Vec3f(170.0f, 200.0f, 210.0f) : cv::Vec3f(150.0f, 90.0f, 40.0f);
+    }
+  }
+  const std::vector<Eigen::Vector2d> specks{{470.0, 100.0}, {560.0, 200.0}, {500.0, 400.0}};
+  for (const Eigen::Vector2d& s : specks) {
+    cv::circle(image, cv::Point(int(s.x()), int(s.y())), 2, cv::Scalar(235, 235, 235), cv::FILLED);
+  }
+  cv::GaussianBlur(image, image, cv::Size(0, 0), 1.0);
+  const Led led{Eigen::Vector2d(530.3, 300.6), 3.0, 7.0};
+  AddLed(led, &image);
+  cv::Mat noise(image.size(), CV_32FC3);
+  cv::randn(noise, 0.0, 2.0);
+  image += noise;
+  cv::Mat bgr;
+  image.convertTo(bgr, CV_8UC3);
+
+  const auto count_specks = [&](const std::vector<LightDetection>& found) {
+    int n = 0;
+    for (const LightDetection& d : found) {
+      for (const Eigen::Vector2d& s : specks) n += (d.uv - s).norm() < 3.0;
+    }
+    return n;
+  };
+  const auto found = BlobLightDetector(BlueOptions()).Detect(bgr);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_LT((found[0].uv - led.uv).norm(), 0.5);
+
+  BlobLightDetectorOptions image_median_only = BlueOptions();
+  image_median_only.checks.surroundings_halo_radii = 0.0;
+  EXPECT_EQ(count_specks(BlobLightDetector(image_median_only).Detect(bgr)), 3);
+}
+
 TEST(BlobLightDetector, EachDetectionCarriesACovariance) {
   const Scene scene = MakeScene(2, false);
   for (const LightDetection& d : BlobLightDetector(BlueOptions()).Detect(scene.bgr)) {
