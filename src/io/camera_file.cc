@@ -12,6 +12,8 @@ namespace auvdock {
 
 namespace {
 
+constexpr int kMaxMatrixSide = 16;
+
 bool IsOpenCvFileStorage(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open file");
@@ -23,6 +25,17 @@ bool IsOpenCvFileStorage(const std::string& path) {
 cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& path, const std::string& key) {
   const cv::FileNode node = fs[key];
   if (node.empty()) throw InputError(path + ": key '" + key + "': missing");
+  // A calibration's matrices are small. OpenCV allocates what rows and cols say before it reads
+  // the data: a malformed size asked it for gigabytes (found by fuzzing).
+  if (node.isMap()) {
+    const cv::FileNode rows = node["rows"], cols = node["cols"];
+    if (!rows.isInt() || !cols.isInt() || static_cast<int>(rows) < 1 ||
+        static_cast<int>(rows) > kMaxMatrixSide || static_cast<int>(cols) < 1 ||
+        static_cast<int>(cols) > kMaxMatrixSide) {
+      throw InputError(path + ": key '" + key + "': rows and cols must be integers from 1 to " +
+                       std::to_string(kMaxMatrixSide));
+    }
+  }
   cv::Mat m;
   try {
     node >> m;

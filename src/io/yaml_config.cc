@@ -1,6 +1,7 @@
 #include "auvdock/io/yaml_config.h"
 
 #include <cmath>
+#include <filesystem>
 #include <sstream>
 
 #include <yaml-cpp/yaml.h>
@@ -38,6 +39,9 @@ ConfigNode& ConfigNode::operator=(const ConfigNode& other) {
 }
 
 ConfigNode ConfigNode::LoadFile(const std::string& path) {
+  // A folder opens as a stream on Linux and fails on the first read with an exception that is
+  // not yaml-cpp's (found by fuzzing: a scenario's `dock: ..`).
+  if (std::filesystem::is_directory(path)) throw InputError(path + ": is a folder, not a file");
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
