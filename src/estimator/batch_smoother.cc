@@ -82,6 +82,45 @@ double MedianStateInterval(const std::vector<std::unique_ptr<BatchState>>& state
   return intervals[intervals.size() / 2];
 }
 
+// Marginal covariance of every pose (tangent space, 6x6; nullopt where it could not be had):
+// by the chain's two sweeps (chain_marginals.h, linear in the number of states); by
+// ceres::Covariance when the problem is not a chain, or when the sweeps find a segment
+// rank-deficient: they work on H = J^T J, whose condition number is the square of J's, and a
+// long stretch on the IMU alone can leave a legitimately small information at rounding level
+// there; the QR of J decides.
+std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> PoseMarginals(
+    ceres::Problem* problem, const std::vector<std::unique_ptr<BatchState>>& states) {
+  std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> marginals(states.size());
+  std::vector<std::vector<double*>> chain;
+  for (const auto& s : states) chain.push_back({s->pose, s->velocity, s->bias});
+  const std::optional<std::vector<std::optional<Eigen::MatrixXd>>> chain_marginals =
+      ChainMarginals(problem, chain);
+  if (chain_marginals &&
+      std::all_of(chain_marginals->begin(), chain_marginals->end(),
+                  [](const std::optional<Eigen::MatrixXd>& m) { return m.has_value(); })) {
+    for (size_t k = 0; k < states.size(); ++k) {
+      const Eigen::Matrix<double, 6, 6> pose = (*chain_marginals)[k]->topLeftCorner<6, 6>();
+      if (pose.allFinite()) marginals[k] = pose;
+    }
+    return marginals;
+  }
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::SPARSE_QR;
+  options.num_threads = 1;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> blocks;
+  for (const auto& s : states) blocks.emplace_back(s->pose, s->pose);
+  if (!covariance.Compute(blocks, problem)) return marginals;
+  for (size_t k = 0; k < states.size(); ++k) {
+    Eigen::Matrix<double, 6, 6, Eigen::RowMajor> pose;
+    if (covariance.GetCovarianceMatrixInTangentSpace({states[k]->pose}, pose.data()) &&
+        pose.allFinite()) {
+      marginals[k] = pose;
+    }
+  }
+  return marginals;
+}
+
 }  // namespace
 
 
@@ -305,31 +344,8 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   result.iterations = static_cast<int>(summary.iterations.size());
   result.converged = summary.termination_type == ceres::CONVERGENCE;
 
-  // Marginal covariance of every pose: by the chain's two sweeps (chain_marginals.h, linear in
-  // the number of states); by ceres::Covariance when the problem is not a chain, or when the
-  // sweeps find a segment rank-deficient: they work on H = J^T J, whose condition number is the
-  // square of J's, and a long stretch on the IMU alone can leave a legitimately small
-  // information at rounding level there; the QR of J decides.
-  std::vector<std::vector<double*>> chain;
-  for (const auto& s : states) chain.push_back({s->pose, s->velocity, s->bias});
-  std::optional<std::vector<std::optional<Eigen::MatrixXd>>> chain_marginals =
-      ChainMarginals(&problem, chain);
-  if (chain_marginals &&
-      std::any_of(chain_marginals->begin(), chain_marginals->end(),
-                  [](const std::optional<Eigen::MatrixXd>& m) { return !m.has_value(); })) {
-    chain_marginals.reset();
-  }
-  ceres::Covariance::Options cov_options;
-  cov_options.algorithm_type = ceres::SPARSE_QR;
-  cov_options.num_threads = 1;
-  ceres::Covariance covariance(cov_options);
-  bool covariance_ok = false;
-  if (!chain_marginals) {
-    std::vector<std::pair<const double*, const double*>> blocks;
-    for (const auto& s : states) blocks.emplace_back(s->pose, s->pose);
-    covariance_ok = covariance.Compute(blocks, &problem);
-  }
-
+  const std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> pose_covariances =
+      PoseMarginals(&problem, states);
   int64_t last_vision = INT64_MIN;
   std::vector<int64_t> dvl_times;  // of the DVL samples kept, for the go/no-go's DVL age
   for (const SensorResidual& r : dvl_residuals) dvl_times.push_back(r.t_ns);
@@ -351,18 +367,9 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
         dvl_after == dvl_times.begin()
             ? -1.0
             : 1e-9 * static_cast<double>(s->t_ns - *std::prev(dvl_after));
-    if (chain_marginals) {
-      const std::optional<Eigen::MatrixXd>& marginal = (*chain_marginals)[k];
-      if (marginal) {
-        out.covariance = marginal->topLeftCorner<6, 6>();
-        out.covariance_ok = out.covariance.allFinite();
-      }
-    } else if (covariance_ok) {
-      Eigen::Matrix<double, 6, 6, Eigen::RowMajor> cov;
-      if (covariance.GetCovarianceMatrixInTangentSpace({s->pose}, cov.data()) && cov.allFinite()) {
-        out.covariance = cov;
-        out.covariance_ok = true;
-      }
+    if (pose_covariances[k]) {
+      out.covariance = *pose_covariances[k];
+      out.covariance_ok = true;
     }
     if (!out.covariance_ok) ++result.stats.covariance_failures;
     const bool finite = out.T_D_B.p.allFinite() && out.T_D_B.q.coeffs().allFinite();
