@@ -45,8 +45,7 @@ void WriteBound(const std::vector<StampedPoseCovariance>& poses, const std::stri
   try {
     CsvWriter csv(partial, PoseCovarianceCsvHeader());
     for (const StampedPoseCovariance& p : poses) {
-      const Eigen::Matrix<double, 6, 6, Eigen::RowMajor> row_major = p.covariance;
-      csv.Row(p.t_ns, std::vector<double>(row_major.data(), row_major.data() + 36));
+      csv.Row(p.t_ns, PoseCovarianceCsvValues(p.covariance));
     }
     csv.Close();
     fs::rename(partial, out);

@@ -40,10 +40,7 @@ void EstimateWriter::Write(const EstimatorOutput& output, const GoNoGoDecision& 
     estimate_csv_->Line(GroundTruthCsvRow(
         {output.t_ns, output.T_D_B, output.v_D, output.bias.gyro, output.bias.accel}));
   }
-  if (output.covariance_ok) {
-    const Eigen::Matrix<double, 6, 6, Eigen::RowMajor> row_major = output.covariance;
-    covariance_.Row(output.t_ns, std::vector<double>(row_major.data(), row_major.data() + 36));
-  }
+  if (output.covariance_ok) covariance_.Row(output.t_ns, PoseCovarianceCsvValues(output.covariance));
   WriteNoEstimate(output.t_ns, decision);
 }
 

@@ -6,6 +6,11 @@
 
 namespace auvdock {
 
+std::vector<double> PoseCovarianceCsvValues(const Eigen::Matrix<double, 6, 6>& covariance) {
+  const Eigen::Matrix<double, 6, 6, Eigen::RowMajor> row_major = covariance;
+  return std::vector<double>(row_major.data(), row_major.data() + 36);
+}
+
 std::string PoseCovarianceCsvHeader() {
   std::string header = "#timestamp [ns]";
   for (int r = 0; r < 6; ++r) {

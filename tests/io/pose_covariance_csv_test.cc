@@ -26,9 +26,21 @@ Eigen::Matrix<double, 6, 6> SomeCovariance(double scale) {
 void WriteRows(const std::string& path, const std::vector<StampedPoseCovariance>& rows) {
   CsvWriter writer(path, PoseCovarianceCsvHeader());
   for (const StampedPoseCovariance& row : rows) {
-    const Eigen::Matrix<double, 6, 6, Eigen::RowMajor> m = row.covariance;
-    writer.Row(row.t_ns, std::vector<double>(m.data(), m.data() + 36));
+    writer.Row(row.t_ns, PoseCovarianceCsvValues(row.covariance));
   }
+}
+
+TEST(PoseCovarianceCsvTest, ValuesAreRowMajorAsTheHeaderSays) {
+  Eigen::Matrix<double, 6, 6> m;
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 6; ++c) m(r, c) = 10 * r + c;
+  }
+  const std::vector<double> values = PoseCovarianceCsvValues(m);
+  ASSERT_EQ(values.size(), 36u);
+  EXPECT_EQ(values[1], 1.0);    // c01
+  EXPECT_EQ(values[6], 10.0);   // c10
+  EXPECT_EQ(values[35], 55.0);  // c55
+  EXPECT_THAT(PoseCovarianceCsvHeader(), HasSubstr(",c00,c01,"));
 }
 
 std::string ReadError(const std::string& path) {

@@ -24,6 +24,9 @@ struct StampedPoseCovariance {
 // The header line, which also says the order and the frame of the tangent space.
 std::string PoseCovarianceCsvHeader();
 
+// The 36 values of a row after its timestamp (row-major).
+std::vector<double> PoseCovarianceCsvValues(const Eigen::Matrix<double, 6, 6>& covariance);
+
 // Reads a covariance file. Throws InputError naming the file and line on a malformed row, a
 // non-finite value, a timestamp that does not increase, or a matrix that is not symmetric
 // (to 1e-9 relative) and positive definite.
