@@ -32,10 +32,12 @@ CameraCalibration ReadCamera(const ConfigNode& node) {
     node.Fail("role", "expected stereo_left, stereo_right, mono or other");
   }
   const auto resolution = node.GetDoubles("resolution");
-  if (resolution.size() != 2 || resolution[0] < 1 || resolution[1] < 1 ||
+  constexpr double kMaxImageSide = 1 << 16;  // before the cast to int (found by fuzzing)
+  if (resolution.size() != 2 || !(resolution[0] >= 1) || !(resolution[1] >= 1) ||
+      resolution[0] > kMaxImageSide || resolution[1] > kMaxImageSide ||
       resolution[0] != static_cast<int>(resolution[0]) ||
       resolution[1] != static_cast<int>(resolution[1])) {
-    node.Fail("resolution", "expected [width, height] in whole pixels");
+    node.Fail("resolution", "expected [width, height] in whole pixels, at most 65536");
   }
   const auto model = node.GetString("camera_model", "pinhole");
   if (model != "pinhole") node.Fail("camera_model", "only 'pinhole' is supported");

@@ -62,13 +62,9 @@ int ReadPositiveInt(const cv::FileStorage& fs, const std::string& path, const st
   return v;
 }
 
-CameraCalibration LoadOpenCvCamera(const std::string& path) {
+CameraCalibration ReadOpenCvCamera(const std::string& path) {
   cv::FileStorage fs;
-  try {
-    fs.open(path, cv::FileStorage::READ);
-  } catch (const cv::Exception& e) {
-    throw InputError(path + ": malformed OpenCV calibration file");
-  }
+  fs.open(path, cv::FileStorage::READ);
   if (!fs.isOpened()) throw InputError(path + ": cannot open OpenCV calibration file");
   const cv::Mat K = ReadMatrix(fs, path, "camera_matrix");
   if (K.rows != 3 || K.cols != 3 || !(K.at<double>(0, 0) > 0) || !(K.at<double>(1, 1) > 0)) {
@@ -87,6 +83,18 @@ CameraCalibration LoadOpenCvCamera(const std::string& path) {
       ReadPositiveInt(fs, path, "image_width"), ReadPositiveInt(fs, path, "image_height"),
       K.at<double>(0, 0), K.at<double>(1, 1), K.at<double>(0, 2), K.at<double>(1, 2), dist);
   return cam;
+}
+
+// OpenCV's parser reports malformed text by cv::Exception and, for some (found by fuzzing), by
+// the standard library's exceptions (std::length_error from a string it sizes by the text).
+CameraCalibration LoadOpenCvCamera(const std::string& path) {
+  try {
+    return ReadOpenCvCamera(path);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(path + ": malformed OpenCV calibration file (" + e.what() + ")");
+  }
 }
 
 }  // namespace

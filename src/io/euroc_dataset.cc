@@ -1,6 +1,7 @@
 #include "euroc_dataset.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "auvdock/io/input_error.h"
@@ -34,8 +35,10 @@ CameraCalibration ReadEurocCamera(const std::string& name, const std::string& ya
   cam.T_B_C = ReadEurocTransform(node);
   cam.rate_hz = node.GetPositive("rate_hz");
   const auto resolution = node.GetDoubles("resolution");
-  if (resolution.size() != 2 || resolution[0] < 1 || resolution[1] < 1) {
-    node.Fail("resolution", "expected [width, height]");
+  if (resolution.size() != 2 || !(resolution[0] >= 1) || !(resolution[1] >= 1) ||
+      resolution[0] > 65536 || resolution[1] > 65536 ||
+      resolution[0] != std::floor(resolution[0]) || resolution[1] != std::floor(resolution[1])) {
+    node.Fail("resolution", "expected [width, height], whole pixels, at most 65536");
   }
   if (node.GetString("camera_model") != "pinhole") {
     node.Fail("camera_model", "only 'pinhole' is supported");

@@ -41,7 +41,10 @@ ConfigNode& ConfigNode::operator=(const ConfigNode& other) {
 ConfigNode ConfigNode::LoadFile(const std::string& path) {
   // A folder opens as a stream on Linux and fails on the first read with an exception that is
   // not yaml-cpp's (found by fuzzing: a scenario's `dock: ..`).
-  if (std::filesystem::is_directory(path)) throw InputError(path + ": is a folder, not a file");
+  std::error_code error;  // a name too long for the file system: the open below says so
+  if (std::filesystem::is_directory(path, error)) {
+    throw InputError(path + ": is a folder, not a file");
+  }
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);

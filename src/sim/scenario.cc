@@ -54,9 +54,9 @@ double GetProbability(const ConfigNode& n, const std::string& key, double fallba
 void ReadCameras(const ConfigNode& n, CameraRigConfig* c) {
   if (n.Has("resolution")) {
     const auto r = n.GetDoubles("resolution");
-    if (r.size() != 2 || r[0] < 16 || r[1] < 16 || r[0] != std::floor(r[0]) ||
-        r[1] != std::floor(r[1])) {
-      n.Fail("resolution", "expected [width, height], whole pixels, at least 16");
+    if (r.size() != 2 || !(r[0] >= 16) || !(r[1] >= 16) || r[0] > 65536 || r[1] > 65536 ||
+        r[0] != std::floor(r[0]) || r[1] != std::floor(r[1])) {
+      n.Fail("resolution", "expected [width, height], whole pixels, 16 to 65536");
     }
     c->width = static_cast<int>(r[0]);
     c->height = static_cast<int>(r[1]);

@@ -343,7 +343,7 @@ TEST(EvaluateTrajectoryTest, NeesOfAKnownErrorAndItsCounts) {
       if (k % 2 == 0) covariances.push_back({pose.t_ns, sqrt_sigma * sqrt_sigma.transpose()});
     }
     const EvaluationReport report =
-        EvaluateTrajectory(truth, estimate, {}, EvaluationOptions(), {covariances, {}});
+        EvaluateTrajectory(truth, estimate, {}, EvaluationOptions(), {covariances, {}, {}});
     EXPECT_EQ(report.overall.nees_n, static_cast<int>(covariances.size()));
     EXPECT_NEAR(report.overall.nees_mean, scale * scale, 1e-6);
     EXPECT_DOUBLE_EQ(report.overall.nees_above_95, scale > 1.0 ? 1.0 : 0.0);
