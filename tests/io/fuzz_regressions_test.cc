@@ -41,6 +41,17 @@ std::vector<fs::path> FilesIn(const fs::path& folder) {
   return files;
 }
 
+// The parsers' scratch folder goes when the tests are done.
+class RemoveScratchFolder : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    std::error_code error;
+    fs::remove_all(fuzz::ScratchFolder(), error);
+  }
+};
+const ::testing::Environment* const kRemoveScratchFolder =
+    ::testing::AddGlobalTestEnvironment(new RemoveScratchFolder);
+
 TEST(FuzzCorpus, EverySeedFolderBelongsToAParser) {
   const std::vector<std::string>& names = fuzz::ParserNames();
   for (const auto& entry : fs::directory_iterator(kSource / "fuzz" / "seeds")) {
