@@ -51,6 +51,9 @@ prepare_corpus() {
   fi
 }
 
+# The parsers' scratch files (fuzz_parsers.h) stay in the build folder.
+export TMPDIR="$PWD/build-fuzz/tmp"
+mkdir -p "$TMPDIR"
 export ASAN_OPTIONS="halt_on_error=1:detect_leaks=1"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 failed=0
