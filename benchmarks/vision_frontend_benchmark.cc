@@ -4,6 +4,7 @@
 //    detection on the stereo-left frame 8 s into the run (all six lights at about 5 m);
 //  * BM_DetectBlob: the real-water detector (BlobLightDetector) on the same frame;
 //  * BM_DetectBlobFixedLevels: the same without the clip level and the neck cut (for the ratio);
+//  * BM_DetectBlobWithoutSurroundings: the same without the surroundings' colour test;
 //  * BM_OpenCvSimpleBlobDetector: OpenCV's blob detector on the same frame, side by side;
 //  * BM_ImageLevels: its reading of the image's noise and clip level (image_levels.h);
 //  * BM_PerFrame: the whole per-frame path of the paper's baseline (PaperBaselinePipeline::Process
@@ -118,6 +119,15 @@ BENCHMARK(BM_DetectBlobFixedLevels)
     ->Args({640, 512})
     ->Args({1280, 1024})
     ->Unit(benchmark::kMillisecond);
+
+// BM_DetectBlob without the surroundings' colour test (light_candidate_checks.h), for the ratio.
+void BM_DetectBlobWithoutSurroundings(benchmark::State& state) {
+  BlobLightDetectorOptions options;
+  options.checks.colour = LightColour::kBlueGreen;
+  options.checks.surroundings_halo_radii = 0.0;
+  TimeDetection(BlobLightDetector(options), state);
+}
+BENCHMARK(BM_DetectBlobWithoutSurroundings)->Args({640, 512})->Unit(benchmark::kMillisecond);
 
 // OpenCV's own building block on the same frame: cv::SimpleBlobDetector on the gray image,
 // bright blobs of at least 3 px, no shape filters (it has no colour, halo or covariance).

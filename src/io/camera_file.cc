@@ -1,7 +1,9 @@
 #include "auvdock/io/camera_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 
 #include <opencv2/core.hpp>
 
@@ -14,12 +16,30 @@ namespace {
 
 constexpr int kMaxMatrixSide = 16;
 
+// Whether the file is an OpenCV FileStorage (YAML or XML), which must then be text: OpenCV
+// 4.6's parser loops forever on a NUL byte (found by fuzzing).
 bool IsOpenCvFileStorage(const std::string& path) {
-  std::ifstream in(path);
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open file");
   std::string first;
   std::getline(in, first);
-  return first.rfind("%YAML", 0) == 0 || first.rfind("<?xml", 0) == 0;
+  if (first.rfind("%YAML", 0) != 0 && first.rfind("<?xml", 0) != 0) return false;
+  in.seekg(0);
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const size_t nul = text.find('\0');
+  if (nul != std::string::npos) {
+    throw InputError(path + ": line " +
+                     std::to_string(1 + std::count(text.begin(), text.begin() + nul, '\n')) +
+                     ": a NUL byte: not a text file");
+  }
+  return true;
+}
+
+// OpenCV's messages span lines; the CLI prints one.
+std::string OneLine(std::string text) {
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  while (!text.empty() && text.back() == ' ') text.pop_back();
+  return text;
 }
 
 cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& path, const std::string& key) {
@@ -93,7 +113,7 @@ CameraCalibration LoadOpenCvCamera(const std::string& path) {
   } catch (const InputError&) {
     throw;
   } catch (const std::exception& e) {
-    throw InputError(path + ": malformed OpenCV calibration file (" + e.what() + ")");
+    throw InputError(path + ": malformed OpenCV calibration file (" + OneLine(e.what()) + ")");
   }
 }
 
