@@ -88,15 +88,24 @@ std::vector<LightDetection> BlobLightDetector::Detect(const cv::Mat& image,
       reject(at, "no contrast");
       continue;
     }
+    const bool close_light = candidate.sigma_px > options_.close_light_min_sigma_px;
+    // A threshold learned from the footage's lights (min_halo_excess) describes them at the
+    // ranges they were seen at; a light within decimetres of the lens whitens its own halo
+    // (saturated, blooming), so it is held to the permissive default only.
+    LightCandidateCheckOptions candidate_checks = checks;
+    if (close_light) {
+      candidate_checks.min_halo_excess =
+          std::min(checks.min_halo_excess, options_.checks.min_halo_excess);
+    }
     const LightCandidateEvidence evidence = MeasureCandidateEvidence(
-        source, luma, *core, candidate.sigma_px, background_excess, checks);
-    const std::string reason = CheckLightCandidate(candidate, *core, evidence, has_colour, checks);
+        source, luma, *core, candidate.sigma_px, background_excess, candidate_checks);
+    const std::string reason =
+        CheckLightCandidate(candidate, *core, evidence, has_colour, candidate_checks);
     if (!reason.empty()) {
       reject(core->uv, reason);
       continue;
     }
     std::string overlap;
-    const bool close_light = candidate.sigma_px > options_.close_light_min_sigma_px;
     for (const Kept& k : kept) {
       if (close_light &&
           (k.detection.uv - core->uv).norm() < options_.halo_extent_sigmas * candidate.sigma_px) {

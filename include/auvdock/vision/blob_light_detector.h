@@ -20,7 +20,10 @@
 // close_light_min_sigma_px (a light within decimetres of the lens, or a large bright structure) are
 // judged after all others and suppress none of them: one is kept only if no kept light lies within
 // halo_extent_sigmas of its sigma (a light that close outshines the others and is far from them in
-// the image; a white funnel's plateau has the dock's lights round it). A detection whose halo ring
+// the image; a white funnel's plateau has the dock's lights round it). Their halo colour is held to
+// checks.min_halo_excess, never to a higher threshold learned from the footage's farther lights:
+// a light that close whitens its own halo (on the randomised renders: 19 more lights closer than
+// 1 m found, of 660 then missed). A detection whose halo ring
 // leaves the image is flagged at_border and its covariance widened by (border_sigma_fraction
 // sigma)^2 per axis: the cut biases the centroid by a fraction of the light's size.
 //
@@ -51,12 +54,13 @@ struct BlobLightDetectorOptions {
   bool adapt_to_clip_level = true;
   // Scale-normalised LoG response of at least 30 gray levels: a light of ~60 levels of contrast
   // at its own scale (lower thresholds let the pool footage's clutter through: at 10, precision
-  // 0.12 on the pool clip). Scales 1.44 apart from 1.5 px (the optics' blur) to 120 px; maxima
-  // at the largest are dropped (blob_candidates.h), so lights up to sigma ~80 px (a saturated
-  // plateau of ~110 px radius: a light a few decimetres from the lens) are found. Large bright
+  // 0.12 on the pool clip). Scales 1.44 apart from 1.5 px (the optics' blur) to 248 px; maxima
+  // at the largest are dropped (blob_candidates.h), so lights up to sigma ~170 px are found: a
+  // light 0.4 m from the lens, its glow filling the image, peaks at ~120 px (at 120 px, the
+  // largest scale until 2026-12, it was dropped as a structure larger than any light). Large bright
   // structures at those scales are told from lights by their shape (light_candidate_checks.h:
   // a large core must be round).
-  BlobCandidateOptions candidates{/*min_sigma_px=*/1.5, /*max_sigma_px=*/119.5, /*num_scales=*/13,
+  BlobCandidateOptions candidates{/*min_sigma_px=*/1.5, /*max_sigma_px=*/248.0, /*num_scales=*/15,
                                   /*min_response=*/30.0};
   double score_response = 60.0;  // a response that scores full strength
   LightCoreOptions core;
