@@ -39,6 +39,9 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                            {"gated", stats.usbl_gated},
                            {"rate_test_rejected", stats.usbl_rate_rejected},
                            {"skipped", stats.usbl_skipped}};
+  summary["sbl_ranges"] = {{"used", stats.sbl_used},
+                           {"gated", stats.sbl_gated},
+                           {"skipped", stats.sbl_skipped}};
   summary["no_vision_reasons"] = source.no_vision_reasons();
   if (source.replaying()) {
     const VisionFrameSource::GivenIdentityCounts& given = source.given_identities();

@@ -1,6 +1,6 @@
 // Feeds a dataset's sensor streams into the sliding window in time order, as `run` and `smooth`
 // both do: the IMU up to the time a prediction is asked for (causal: samples at or before it),
-// and before each frame every stream (IMU, depth, DVL, acoustic fixes) up to the frame's last
+// and before each frame every stream (IMU, depth, DVL, acoustic fixes, SBL ranges) up to the frame's last
 // image (an acoustic fix by its arrival time, AcousticFix::arrival_t_ns).
 #pragma once
 
@@ -39,6 +39,9 @@ class SensorFeed {
            dataset_.acoustic[next_usbl_].arrival_t_ns() <= t_ns) {
       estimator_->AddUsbl(dataset_.acoustic[next_usbl_++]);
     }
+    while (next_sbl_ < dataset_.sbl.size() && dataset_.sbl[next_sbl_].t_ns <= t_ns) {
+      estimator_->AddSblRange(dataset_.sbl[next_sbl_++]);
+    }
   }
 
  private:
@@ -48,6 +51,7 @@ class SensorFeed {
   size_t next_depth_ = 0;
   size_t next_dvl_ = 0;
   size_t next_usbl_ = 0;
+  size_t next_sbl_ = 0;
 };
 
 }  // namespace auvdock

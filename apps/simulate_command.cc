@@ -63,9 +63,11 @@ void RunSimulate(const SimulateOptions& options) {
   std::printf("simulated '%s' (seed %llu): %.1f s of data in %.1f s wall time -> %s\n",
               scenario.name.c_str(), static_cast<unsigned long long>(scenario.seed),
               scenario.duration_s, wall_s, out.final_path().c_str());
-  std::printf("  %d camera frames x %zu cameras, %d IMU, %d depth, %d DVL, %d acoustic, %d faults\n",
+  std::printf("  %d camera frames x %zu cameras, %d IMU, %d depth, %d DVL, %d acoustic, ",
               summary.n_camera_frames, simulator.calibration().cameras.size(), summary.n_imu,
-              summary.n_depth, summary.n_dvl, summary.n_acoustic, summary.n_faults);
+              summary.n_depth, summary.n_dvl, summary.n_acoustic);
+  if (simulator.calibration().sbl) std::printf("%d SBL ranges, ", summary.n_sbl_ranges);
+  std::printf("%d faults\n", summary.n_faults);
   std::printf("  max speed %.2f m/s; stages:", summary.max_speed_mps);
   for (int i = 0; i < 4; ++i) {
     std::printf(" %s %.1f s", VisibilityStageName(static_cast<VisibilityStage>(i)),

@@ -89,7 +89,8 @@ void Smooth(const SmoothOptions& options) {
       dataset.calibration, *dataset.dock, frames, dataset.imu, estimator.History(),
       config.estimator, batch,
       NavigationSamples{dataset.depth, dataset.dvl, estimator.stats().dvl_variance_factor,
-                        estimator.stats().depth_variance_factor, dataset.acoustic});
+                        estimator.stats().depth_variance_factor, dataset.acoustic,
+                        dataset.sbl});
   counters.backend_s += Seconds(Clock::now() - t0);
   if (!options.quiet) std::fprintf(stderr, "\n");
 
@@ -126,6 +127,9 @@ void Smooth(const SmoothOptions& options) {
   stats.usbl_used = result.stats.usbl_used;
   stats.usbl_gated = result.stats.usbl_gated;
   stats.usbl_skipped = result.stats.usbl_skipped;
+  stats.sbl_used = result.stats.sbl_used;
+  stats.sbl_gated = result.stats.sbl_gated;
+  stats.sbl_skipped = result.stats.sbl_skipped;
   nlohmann::json summary = MakeRunSummary(source, stats, skipped_rows, counters);
   summary["batch"] = {{"segments", result.segments},
                       {"iterations", result.iterations},

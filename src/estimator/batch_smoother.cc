@@ -275,6 +275,29 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
       }
     }
   }
+  std::vector<SensorResidual> sbl_residuals;
+  if (estimator_options.use_sbl && calibration.sbl) {
+    int64_t last_t_ns = INT64_MIN;
+    int last_transducer = -1;
+    for (const SblRange& range : sensors.sbl) {
+      const bool in_order = range.t_ns > last_t_ns ||
+                            (range.t_ns == last_t_ns && range.transducer > last_transducer);
+      std::optional<ceres::ResidualBlockId> id;
+      BatchState* s = in_order ? state_at_or_before(range.t_ns) : nullptr;
+      if (s) id = AddSblFactor(&problem, range, *calibration.sbl, dock, blocks_of(s), s->t_ns);
+      if (id) {
+        sbl_residuals.push_back({*id, range.t_ns});
+        last_t_ns = range.t_ns;
+        last_transducer = range.transducer;
+      } else {
+        ++result.stats.sbl_skipped;
+        result.rejections.push_back({range.t_ns, calibration.sbl->name, kNoStatistic,
+                                     !in_order ? "out of order or repeated"
+                                     : s       ? "not finite or unknown transducer"
+                                               : kNoStateReason});
+      }
+    }
+  }
 
   ceres::Solver::Options solver;
   solver.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
@@ -309,6 +332,10 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   result.stats.depth_gated = gate_depth();
   result.stats.dvl_gated = gate_dvl();
   result.stats.usbl_gated = gate_usbl();
+  const auto gate_sbl = [&] {
+    return gate(&sbl_residuals, estimator_options.sbl_gate_chi2, calibration.sbl);
+  };
+  result.stats.sbl_gated = gate_sbl();
   ceres::Solver::Summary summary;
   ceres::Solve(solver, &problem, &summary);
   result.initial_cost = summary.initial_cost;
@@ -328,7 +355,11 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   const int usbl_gated_after = gate_usbl();
   result.stats.usbl_gated += usbl_gated_after;
   result.stats.usbl_used = static_cast<int>(usbl_residuals.size());
-  if (gated > 0 || depth_gated_after > 0 || dvl_gated_after > 0 || usbl_gated_after > 0) {
+  const int sbl_gated_after = gate_sbl();
+  result.stats.sbl_gated += sbl_gated_after;
+  result.stats.sbl_used = static_cast<int>(sbl_residuals.size());
+  if (gated > 0 || depth_gated_after > 0 || dvl_gated_after > 0 || usbl_gated_after > 0 ||
+      sbl_gated_after > 0) {
     ceres::Solve(solver, &problem, &summary);
   }
   std::stable_sort(result.rejections.begin(), result.rejections.end(),

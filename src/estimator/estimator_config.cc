@@ -31,6 +31,8 @@ RunConfig LoadRunConfig(const std::string& path) {
       est.GetPositive("usbl_rate_max_speed_mps", e.usbl_rate_test.max_speed_mps);
   e.usbl_max_backward_shift_s =
       est.GetNonNegative("usbl_max_backward_shift_s", e.usbl_max_backward_shift_s);
+  e.use_sbl = est.GetBool("use_sbl", e.use_sbl);
+  e.sbl_gate_chi2 = est.GetNonNegative("sbl_gate_chi2", e.sbl_gate_chi2);
   e.dvl_rate_test.enabled = est.GetBool("dvl_rate_test", e.dvl_rate_test.enabled);
   e.dvl_rate_test.gate_chi2 = est.GetPositive("dvl_rate_gate_chi2", e.dvl_rate_test.gate_chi2);
   e.dvl_rate_test.accel_sigma_mps2 =

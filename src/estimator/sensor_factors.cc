@@ -7,6 +7,7 @@
 #include "factors/depth_factor.h"
 #include "factors/dvl_factor.h"
 #include "factors/time_shifted_factor.h"
+#include "factors/sbl_range_factor.h"
 #include "factors/usbl_fix_factor.h"
 
 namespace auvdock {
@@ -67,6 +68,28 @@ std::optional<ceres::ResidualBlockId> AddUsblFactor(ceres::Problem* problem,
   return AddOnState<UsblFixFactor, kUsblResidualSize>(
       problem, std::make_unique<UsblFixFactor>(fix.p_D, fix.sigma_m, calibration.T_B_S.p), *shift,
       nullptr, state);
+}
+
+std::optional<ceres::ResidualBlockId> AddSblFactor(ceres::Problem* problem,
+                                                   const SblRange& range,
+                                                   const SblCalibration& calibration,
+                                                   const DockModel& dock,
+                                                   const StateBlocks& state, int64_t t_state_ns) {
+  if (range.transducer < 0 ||
+      range.transducer >= static_cast<int>(calibration.p_B_transducers.size()) ||
+      !std::isfinite(range.range_m) || range.range_m < 0.0 || !std::isfinite(range.sigma_m) ||
+      !(range.sigma_m > 0.0) || range.t_ns < t_state_ns) {
+    return std::nullopt;
+  }
+  const std::optional<ImuPoseShift> shift =
+      ImuShiftFromState(state, t_state_ns, range.t_ns - t_state_ns, dock.gravity_D);
+  if (!shift) return std::nullopt;
+  return AddOnState<SblRangeFactor, kSblRangeResidualSize>(
+      problem,
+      std::make_unique<SblRangeFactor>(range.range_m, range.sigma_m,
+                                       calibration.p_B_transducers[range.transducer],
+                                       dock.p_D_beacon),
+      *shift, nullptr, state);
 }
 
 std::string ImplausibleDepth(const DepthMeasurement& sample) {

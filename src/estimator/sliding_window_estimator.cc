@@ -275,6 +275,38 @@ void SlidingWindowEstimator::AddUsbl(const AcousticFix& fix) {
   pending_usbl_.push_back(fix);
 }
 
+void SlidingWindowEstimator::AddSblRange(const SblRange& range) {
+  if (!options_.use_sbl || !calibration_.sbl) return;
+  std::string problem;
+  const int n_transducers = static_cast<int>(calibration_.sbl->p_B_transducers.size());
+  if (!std::isfinite(range.range_m) || range.range_m < 0.0 || !std::isfinite(range.sigma_m) ||
+      !(range.sigma_m > 0.0)) {
+    problem = "not finite, negative or no positive sigma";
+  } else if (range.transducer < 0 || range.transducer >= n_transducers) {
+    problem = "transducer " + std::to_string(range.transducer) + " not in the calibration";
+  } else if (range.t_ns < last_sbl_sample_t_ns_ ||
+             (range.t_ns == last_sbl_sample_t_ns_ && range.transducer <= last_sbl_transducer_)) {
+    problem = "out of order or repeated";
+  }
+  if (!problem.empty()) {
+    ++stats_.sbl_skipped;
+    rejections_.push_back({range.t_ns, calibration_.sbl->name, kNoStatistic, problem});
+    return;
+  }
+  last_sbl_sample_t_ns_ = range.t_ns;
+  last_sbl_transducer_ = range.transducer;
+  pending_sbl_.push_back(range);
+}
+
+std::vector<SensorResidual> SlidingWindowEstimator::AttachSbl(int64_t t_ns) {
+  if (!calibration_.sbl) return {};
+  return AttachPending(&pending_sbl_, t_ns, calibration_.sbl->name, &stats_.sbl_skipped,
+                       [&](const SblRange& range, State& state) {
+                         return AddSblFactor(problem_.get(), range, *calibration_.sbl, dock_,
+                                             BlocksOf(state), state.t_ns);
+                       });
+}
+
 std::vector<SensorResidual> SlidingWindowEstimator::AttachUsbl(int64_t t_ns) {
   return AttachPending(&pending_usbl_, t_ns, calibration_.acoustic->name, &stats_.usbl_skipped,
                        [&](const AcousticFix& fix, State& state) {
@@ -472,6 +504,7 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   std::vector<SensorResidual> depth = AttachDepth(frame.t_ns);
   std::vector<SensorResidual> dvl = AttachDvl(frame.t_ns);
   std::vector<SensorResidual> usbl = AttachUsbl(frame.t_ns);
+  std::vector<SensorResidual> sbl = AttachSbl(frame.t_ns);
 
   if (!Solve()) {
     ++stats_.solver_failures;
@@ -497,12 +530,16 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
       gate(&dvl, options_.dvl_gate_chi2, calibration_.dvl, &stats_.dvl_gated, &stats_.dvl_used);
   const int usbl_gated = gate(&usbl, options_.usbl_gate_chi2, calibration_.acoustic,
                               &stats_.usbl_gated, &stats_.usbl_used);
+  const int sbl_gated = gate(&sbl, options_.sbl_gate_chi2, calibration_.sbl, &stats_.sbl_gated,
+                             &stats_.sbl_used);
   for (const SensorResidual& kept : usbl) usbl_rate_test_.Confirm(kept.t_ns);
   for (const SensorResidual& kept : dvl) {
     dvl_rate_test_.Confirm(kept.t_ns);
     last_dvl_t_ns_ = std::max(last_dvl_t_ns_, kept.t_ns);
   }
-  if ((state->n_gated > 0 || depth_gated > 0 || dvl_gated > 0 || usbl_gated > 0) && !Solve()) {
+  if ((state->n_gated > 0 || depth_gated > 0 || dvl_gated > 0 || usbl_gated > 0 ||
+       sbl_gated > 0) &&
+      !Solve()) {
     ++stats_.solver_failures;
     Reset("solver failed at " + std::to_string(frame.t_ns) + " ns (after gating)");
     return std::nullopt;

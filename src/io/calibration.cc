@@ -119,6 +119,24 @@ Calibration LoadCalibration(const std::string& path) {
     ac.sigma_range_fraction = n.GetNonNegative("sigma_range_fraction", 0.0);
     calibration.acoustic = ac;
   }
+  if (root.Has("sbl")) {
+    const ConfigNode n = root.Child("sbl");
+    SblCalibration sbl;
+    sbl.name = n.GetString("name", sbl.name);
+    sbl.rate_hz = n.GetPositive("rate_hz");
+    sbl.sigma_min_m = n.GetPositive("sigma_min_m");
+    sbl.sigma_range_fraction = n.GetNonNegative("sigma_range_fraction", 0.0);
+    for (const ConfigNode& t : n.Children("transducers")) {
+      const Eigen::Vector3d p_B = t.GetVector<3>("p_B");
+      if (!p_B.allFinite()) t.Fail("p_B", "expected 3 finite numbers");
+      sbl.p_B_transducers.push_back(p_B);
+      t.CheckNoUnknownKeys();
+    }
+    if (sbl.p_B_transducers.empty() || sbl.p_B_transducers.size() > 16) {
+      n.Fail("transducers", "expected 1 to 16 transducers");
+    }
+    calibration.sbl = sbl;
+  }
   root.CheckNoUnknownKeys();
   return calibration;
 }
@@ -183,6 +201,21 @@ void SaveCalibration(const Calibration& calibration, const std::string& path) {
     EmitNumber(out, "sigma_range_fraction", s.sigma_range_fraction);
     EmitTransform(out, "T_B_S", s.T_B_S);
     out << YAML::EndMap;
+  }
+  if (calibration.sbl) {
+    const auto& s = *calibration.sbl;
+    out << YAML::Key << "sbl" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << s.name;
+    EmitNumber(out, "rate_hz", s.rate_hz);
+    EmitNumber(out, "sigma_min_m", s.sigma_min_m);
+    EmitNumber(out, "sigma_range_fraction", s.sigma_range_fraction);
+    out << YAML::Key << "transducers" << YAML::Value << YAML::BeginSeq;
+    for (const Eigen::Vector3d& p : s.p_B_transducers) {
+      out << YAML::BeginMap;
+      EmitVector3(out, "p_B", p);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq << YAML::EndMap;
   }
   out << YAML::EndMap;
   WriteYamlFile(path,

@@ -47,6 +47,11 @@ Dataset LoadAuvdockDataset(const fs::path& root, std::vector<std::string>* skipp
     const std::string csv = SensorCsv(root, ds.calibration.acoustic->name);
     if (!csv.empty()) ds.acoustic = ReadAcousticCsv(csv, skipped);
   }
+  if (ds.calibration.sbl) {
+    const std::string csv = SensorCsv(root, ds.calibration.sbl->name);
+    const int n = static_cast<int>(ds.calibration.sbl->p_B_transducers.size());
+    if (!csv.empty()) ds.sbl = ReadSblCsv(csv, n, skipped);
+  }
   const fs::path gt = root / "groundtruth";
   if (fs::exists(gt / "data.csv")) ds.groundtruth = ReadGroundTruthCsv((gt / "data.csv").string());
   if (fs::exists(gt / "visibility.csv")) {

@@ -40,6 +40,7 @@ DatasetWriter::DatasetWriter(const std::string& root, const Calibration& calibra
   if (calibration.acoustic) {
     acoustic_ = OpenSensor(r, calibration.acoustic->name, kAcousticCsvHeader);
   }
+  if (calibration.sbl) sbl_ = OpenSensor(r, calibration.sbl->name, kSblCsvHeader);
   groundtruth_ = OpenSensor(r, "groundtruth", kGroundTruthCsvHeader);
   visibility_ = std::make_unique<CsvWriter>((r / "groundtruth" / "visibility.csv").string(),
                                             kVisibilityCsvHeader);
@@ -52,6 +53,7 @@ void DatasetWriter::AddImu(const ImuSample& s) { imu_->Line(ImuCsvRow(s)); }
 void DatasetWriter::AddDepth(const DepthMeasurement& m) { depth_->Line(DepthCsvRow(m)); }
 void DatasetWriter::AddDvl(const DvlMeasurement& m) { dvl_->Line(DvlCsvRow(m)); }
 void DatasetWriter::AddAcoustic(const AcousticFix& m) { acoustic_->Line(AcousticCsvRow(m)); }
+void DatasetWriter::AddSbl(const SblRange& m) { sbl_->Line(SblCsvRow(m)); }
 void DatasetWriter::AddVisibility(const VisibilityRecord& r) {
   visibility_->Line(VisibilityCsvRow(r));
 }
@@ -124,7 +126,7 @@ void DatasetWriter::WriteImageFile(const std::string& camera, int64_t t_ns,
 }
 
 void DatasetWriter::Close() {
-  for (auto* w : {&imu_, &depth_, &dvl_, &acoustic_, &groundtruth_, &visibility_, &faults_}) {
+  for (auto* w : {&imu_, &depth_, &dvl_, &acoustic_, &sbl_, &groundtruth_, &visibility_, &faults_}) {
     if (*w) (*w)->Close();
   }
   for (auto& [name, w] : cameras_) w->Close();

@@ -15,6 +15,7 @@ const char kDepthCsvHeader[] = "#timestamp [ns],depth [m]";
 const char kDvlCsvHeader[] = "#timestamp [ns],v_S_x [m s^-1],v_S_y [m s^-1],v_S_z [m s^-1]";
 const char kAcousticCsvHeader[] =
     "#timestamp [ns],p_D_x [m],p_D_y [m],p_D_z [m],sigma [m],latency [ns]";
+const char kSblCsvHeader[] = "#timestamp [ns],transducer,range [m],sigma [m]";
 const char kGroundTruthCsvHeader[] =
     "#timestamp,p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z [],"
     "v_RS_R_x [m s^-1],v_RS_R_y [m s^-1],v_RS_R_z [m s^-1],"
@@ -157,6 +158,48 @@ std::vector<AcousticFix> ReadAcousticCsv(const std::string& path,
   return out;
 }
 
+std::vector<SblRange> ReadSblCsv(const std::string& path, int num_transducers,
+                                 std::vector<std::string>* skipped) {
+  CsvReader reader(path, {"timestamp", "transducer", "range", "sigma"});
+  std::vector<SblRange> out;
+  int64_t previous_t = kNoTime;
+  int previous_transducer = -1;
+  while (reader.Next()) {
+    const int64_t t = reader.Int64(0);
+    const int64_t transducer = reader.Int64(1);
+    if (transducer < 0 || transducer >= num_transducers) {
+      reader.FailColumn(1, "expected a transducer index from 0 to " +
+                               std::to_string(num_transducers - 1) + " (the calibration's)");
+    }
+    const bool in_order =
+        previous_t == kNoTime || t > previous_t ||
+        (t == previous_t && transducer > previous_transducer);
+    std::string why;
+    if (reader.HasNonFiniteNumber(2, 3)) {
+      why = "NaN/Inf";
+    } else if (!in_order) {
+      why = "not after the previous row (timestamp, then transducer, must increase)";
+    }
+    if (!why.empty()) {
+      if (skipped == nullptr) reader.Fail(why);
+      skipped->push_back(path + ": line " + std::to_string(reader.line()) + ": " + why +
+                         ": row skipped");
+      continue;
+    }
+    SblRange m;
+    m.t_ns = t;
+    m.transducer = static_cast<int>(transducer);
+    m.range_m = reader.Double(2);
+    if (m.range_m < 0.0) reader.FailColumn(2, "a range cannot be negative");
+    m.sigma_m = reader.Double(3);
+    if (!(m.sigma_m > 0.0)) reader.FailColumn(3, "must be positive");
+    previous_t = t;
+    previous_transducer = m.transducer;
+    out.push_back(m);
+  }
+  return out;
+}
+
 std::vector<GroundTruthState> ReadGroundTruthCsv(const std::string& path) {
   CsvReader reader(path, {"timestamp", "p_RS_R_x", "p_RS_R_y", "p_RS_R_z", "q_RS_w", "q_RS_x",
                           "q_RS_y", "q_RS_z", "v_RS_R_x", "v_RS_R_y", "v_RS_R_z", "b_w_RS_S_x",
@@ -224,6 +267,11 @@ std::string DvlCsvRow(const DvlMeasurement& m) {
 std::string AcousticCsvRow(const AcousticFix& m) {
   return Join(m.t_ns, {m.p_D.x(), m.p_D.y(), m.p_D.z(), m.sigma_m}) + "," +
          std::to_string(m.latency_ns);
+}
+
+std::string SblCsvRow(const SblRange& m) {
+  return std::to_string(m.t_ns) + "," + std::to_string(m.transducer) + "," +
+         FormatDouble(m.range_m) + "," + FormatDouble(m.sigma_m);
 }
 
 std::string GroundTruthCsvRow(const GroundTruthState& s) {

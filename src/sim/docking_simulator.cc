@@ -11,6 +11,7 @@
 #include "auvdock/io/csv.h"
 #include "auvdock/io/dataset_writer.h"
 #include "auvdock/sim/acoustic_simulator.h"
+#include "auvdock/sim/sbl_simulator.h"
 #include "auvdock/sim/depth_simulator.h"
 #include "auvdock/sim/dvl_simulator.h"
 #include "auvdock/sim/imu_simulator.h"
@@ -90,6 +91,10 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
   DvlSimulator dvl(s.dvl, s.dvl_faults, noisy, MakeRandomStream(s.seed, RandomStreamId::kDvl));
   AcousticSimulator acoustic(s.acoustic, s.dock, s.acoustic_faults, noisy,
                              MakeRandomStream(s.seed, RandomStreamId::kAcoustic));
+  std::optional<SblSimulator> sbl;
+  if (s.sbl) {
+    sbl.emplace(*s.sbl, s.dock, s.sbl_faults, noisy, MakeRandomStream(s.seed, RandomStreamId::kSbl));
+  }
   std::vector<SyntheticDetector> detectors;  // without images: each camera's front-end
   if (!s.cameras.render_images) {
     for (std::size_t i = 0; i < calibration_.cameras.size(); ++i) {
@@ -104,8 +109,9 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
   const int64_t n_depth = SampleCount(s.duration_s, s.depth.rate_hz);
   const int64_t n_dvl = SampleCount(s.duration_s, s.dvl.rate_hz);
   const int64_t n_acoustic = SampleCount(s.duration_s, s.acoustic.rate_hz);
+  const int64_t n_sbl = s.sbl ? SampleCount(s.duration_s, s.sbl->rate_hz) : 0;
   const int64_t n_frames = SampleCount(s.duration_s, s.cameras.rate_hz);
-  int64_t k_imu = 0, k_depth = 0, k_dvl = 0, k_acoustic = 0;
+  int64_t k_imu = 0, k_depth = 0, k_dvl = 0, k_acoustic = 0, k_sbl = 0;
 
   auto record_fault = [&](const std::optional<FaultRecord>& fault) {
     if (fault) {
@@ -145,6 +151,15 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
       writer.AddAcoustic(acoustic.Sample(t, trajectory_.At(Seconds(t)), &fault));
       record_fault(fault);
       ++summary.n_acoustic;
+    }
+    for (; k_sbl < n_sbl && SampleTime(k_sbl, s.sbl->rate_hz) <= t_end_ns; ++k_sbl) {
+      const int64_t t = SampleTime(k_sbl, s.sbl->rate_hz);
+      std::vector<FaultRecord> faults;
+      for (const SblRange& range : sbl->Ping(t, trajectory_.At(Seconds(t)), &faults)) {
+        writer.AddSbl(range);
+        ++summary.n_sbl_ranges;
+      }
+      for (const FaultRecord& fault : faults) record_fault(fault);
     }
   };
 

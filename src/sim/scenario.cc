@@ -115,6 +115,31 @@ void ReadRandomization(const ConfigNode& n, RenderRandomization* r) {
 }
 
 
+
+// `sbl:` (seed 001): four transducers at the corners of an a x b rectangle in the hull's
+// bottom plane, T0 (a/2, -b/2), T1 (a/2, b/2), T2 (-a/2, b/2), T3 (-a/2, -b/2), at z = plane_z_m
+// in B (x forward, y right, z down).
+SblCalibration LoadSbl(const ConfigNode& n, SblFaultConfig* faults) {
+  SblCalibration sbl;
+  sbl.rate_hz = n.GetPositive("rate_hz", sbl.rate_hz);
+  sbl.sigma_min_m = n.GetPositive("sigma_min_m", sbl.sigma_min_m);
+  sbl.sigma_range_fraction = n.GetNonNegative("sigma_range_fraction", sbl.sigma_range_fraction);
+  const Eigen::Vector2d ab = n.GetVector<2>("array_m", Eigen::Vector2d(0.8, 0.3));
+  if (!(ab.x() > 0.0) || !(ab.y() > 0.0) || !ab.allFinite()) {
+    n.Fail("array_m", "expected [a, b]: the array's positive length and width (m)");
+  }
+  const double z = n.GetDouble("plane_z_m", 0.2);
+  const double a = 0.5 * ab.x(), b = 0.5 * ab.y();
+  sbl.p_B_transducers = {{a, -b, z}, {a, b, z}, {-a, b, z}, {-a, -b, z}};
+  faults->min_range_m = n.GetNonNegative("min_range_m", faults->min_range_m);
+  faults->dropout_probability =
+      GetProbability(n, "dropout_probability", faults->dropout_probability);
+  faults->outlier_probability =
+      GetProbability(n, "outlier_probability", faults->outlier_probability);
+  faults->outlier_m = n.GetNonNegative("outlier_m", faults->outlier_m);
+  return sbl;
+}
+
 }  // namespace
 
 Scenario LoadScenario(const std::string& path) {
@@ -191,6 +216,7 @@ Scenario LoadScenario(const std::string& path) {
   if (s.acoustic_faults.latency_max_s < s.acoustic_faults.latency_min_s) {
     ac.Fail("latency_max_s", "must not be below latency_min_s");
   }
+  if (root.Has("sbl")) s.sbl = LoadSbl(root.Child("sbl"), &s.sbl_faults);
 
   root.CheckNoUnknownKeys();
   return s;
@@ -249,6 +275,7 @@ Calibration MakeCalibration(const Scenario& s) {
   cal.depth = s.depth;
   cal.dvl = s.dvl;
   cal.acoustic = s.acoustic;
+  cal.sbl = s.sbl;
   return cal;
 }
 
@@ -257,6 +284,8 @@ void ScaleFaultRates(double factor, Scenario* s) {
   s->dvl_faults.gross_error_probability = probability(s->dvl_faults.gross_error_probability);
   s->dvl_faults.bias_rate_per_min *= factor;
   s->acoustic_faults.outlier_probability = probability(s->acoustic_faults.outlier_probability);
+  s->sbl_faults.outlier_probability = probability(s->sbl_faults.outlier_probability);
+  s->sbl_faults.dropout_probability = probability(s->sbl_faults.dropout_probability);
   SyntheticDetectionConfig& d = s->cameras.synthetic_detections;
   d.miss_probability = probability(d.miss_probability);
   d.spurious_per_frame *= factor;

@@ -11,6 +11,8 @@
 //                                  the gyro held at t minus the state's gyro bias
 //   USBL   factors/usbl_fix_factor.h  3 residuals, on the pose (and the velocity when shifted);
 //                                  the fix's own sigma (range-dependent, from the sensor)
+//   SBL    factors/sbl_range_factor.h  1 residual per range, on the pose (and the velocity
+//                                  when shifted); the range's own sigma
 #pragma once
 
 #include <cstdint>
@@ -60,6 +62,14 @@ std::optional<ceres::ResidualBlockId> AddUsblFactor(ceres::Problem* problem,
                                                     const AcousticCalibration& calibration,
                                                     const DockModel& dock,
                                                     const StateBlocks& state, int64_t t_state_ns);
+
+// The same for one SBL range (the beacon at dock.p_D_beacon); nothing also when its transducer
+// is not in the calibration or its sigma is not positive and finite.
+std::optional<ceres::ResidualBlockId> AddSblFactor(ceres::Problem* problem,
+                                                   const SblRange& range,
+                                                   const SblCalibration& calibration,
+                                                   const DockModel& dock,
+                                                   const StateBlocks& state, int64_t t_state_ns);
 
 // Why a sample cannot be a measurement whatever the state (empty when it can): a depth above
 // the surface by more than 0.5 m (a pressure sensor reads slightly negative at the surface, a

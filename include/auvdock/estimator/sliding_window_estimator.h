@@ -159,6 +159,10 @@ struct EstimatorOptions {
   // before initialisation and arriving after it caused 5 of the 7 Monte-Carlo runs with unsafe
   // GO, README).
   double usbl_max_backward_shift_s = 1.0;
+  // Short-baseline ranges (the same, needs the calibration's sbl array and the dock's beacon):
+  // each range on its own, 1 dof, p = 0.999, with its own sigma.
+  bool use_sbl = true;
+  double sbl_gate_chi2 = 10.83;
   // Multiplies the calibration's IMU noise densities and random walks (sigma, not variance).
   // Datasheet values are measured on a bench, at constant temperature, without vibration; on a
   // vehicle the effective noise is larger (a real EuRoC sequence gives a chi-square about 100x
@@ -214,6 +218,9 @@ struct EstimatorStats {
   int usbl_gated = 0;     // beyond the USBL gate
   int usbl_skipped = 0;   // not finite, out of order, no state or IMU
   int usbl_rate_rejected = 0;  // failed the rate-of-change test
+  int sbl_used = 0;       // SBL ranges in the cost (after gating)
+  int sbl_gated = 0;      // beyond the SBL gate
+  int sbl_skipped = 0;    // not finite, unknown transducer, out of order, no state or IMU
   // The adaptive variance factors in use at the end, per light id.
   std::map<int, double> mono_variance_factor;
   std::map<int, double> stereo_variance_factor;
@@ -251,6 +258,8 @@ class SlidingWindowEstimator {
   void AddDvl(const DvlMeasurement& sample);
   // An acoustic fix, the same way (by its measurement time).
   void AddUsbl(const AcousticFix& fix);
+  // An SBL range, the same way (by its ping's time).
+  void AddSblRange(const SblRange& range);
 
   // A camera frame (identified lights; possibly none). Returns the newest state's estimate, or
   // nothing before initialisation / after a reset until the next per-frame pose.
@@ -285,6 +294,7 @@ class SlidingWindowEstimator {
   std::vector<SensorResidual> AttachDepth(int64_t t_ns);
   std::vector<SensorResidual> AttachDvl(int64_t t_ns);
   std::vector<SensorResidual> AttachUsbl(int64_t t_ns);
+  std::vector<SensorResidual> AttachSbl(int64_t t_ns);
   // The pending samples up to t_ns, each by add(sample, state) onto StateFor(its time,
   // max_before_s) (the factor, or nothing: then, as without a state, skipped with
   // kNoStateReason).
@@ -318,6 +328,7 @@ class SlidingWindowEstimator {
   std::deque<DepthMeasurement> pending_depth_;
   std::deque<DvlMeasurement> pending_dvl_;
   std::deque<AcousticFix> pending_usbl_;
+  std::deque<SblRange> pending_sbl_;
   std::vector<Rejection> rejections_;  // not yet taken
   DvlRateTest dvl_rate_test_;
   AdaptiveNoiseScale dvl_noise_;  // the DVL's variance factor (adaptive_dvl_noise)
@@ -328,6 +339,8 @@ class SlidingWindowEstimator {
   int64_t last_depth_sample_t_ns_ = INT64_MIN;  // of the newest sample taken
   int64_t last_dvl_sample_t_ns_ = INT64_MIN;
   int64_t last_usbl_sample_t_ns_ = INT64_MIN;
+  int64_t last_sbl_sample_t_ns_ = INT64_MIN;  // and its transducer: (time, transducer) increase
+  int last_sbl_transducer_ = -1;
   int64_t last_frame_t_ns_ = INT64_MIN;
   int64_t first_state_t_ns_ = INT64_MIN;  // since the last initialisation
   int64_t last_vision_t_ns_ = INT64_MIN;

@@ -46,12 +46,24 @@ struct AcousticCalibration {
   double sigma_range_fraction = 0.005;  // 1-sigma grows as this fraction of slant range
 };
 
+// A short-baseline (SBL) array (seed 001): transducers on the hull, each ranging to the dock's
+// beacon (dock.yaml beacon_p_D). Seed 001's four transducers are the corners of an a x b
+// rectangle in the hull's bottom plane.
+struct SblCalibration {
+  std::string name = "sbl0";
+  std::vector<Eigen::Vector3d> p_B_transducers;  // each transducer's position in B (m)
+  double rate_hz = 2.0;                // pings per second
+  double sigma_min_m = 0.02;           // floor of a range's 1-sigma error
+  double sigma_range_fraction = 0.002;  // 1-sigma grows as this fraction of the range
+};
+
 struct Calibration {
   std::vector<CameraCalibration> cameras;
   std::optional<ImuCalibration> imu;
   std::optional<DepthCalibration> depth;
   std::optional<DvlCalibration> dvl;
   std::optional<AcousticCalibration> acoustic;
+  std::optional<SblCalibration> sbl;
 
   const CameraCalibration* FindCamera(const std::string& name) const;
   const CameraCalibration* FindCameraByRole(CameraRole role) const;

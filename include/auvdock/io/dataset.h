@@ -27,6 +27,7 @@ struct Dataset {
   std::vector<DepthMeasurement> depth;
   std::vector<DvlMeasurement> dvl;
   std::vector<AcousticFix> acoustic;
+  std::vector<SblRange> sbl;  // SBL ranges (calibration.sbl)
   std::map<std::string, std::vector<CameraFrame>> camera_frames;  // by camera name; absolute paths
   std::vector<GroundTruthState> groundtruth;                      // empty if none
   std::vector<VisibilityRecord> visibility;                       // empty if unknown

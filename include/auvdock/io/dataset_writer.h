@@ -29,6 +29,7 @@ class DatasetWriter {
   void AddDepth(const DepthMeasurement& m);
   void AddDvl(const DvlMeasurement& m);
   void AddAcoustic(const AcousticFix& m);
+  void AddSbl(const SblRange& m);
   // Writes <camera>/data/<t_ns>.png (lossless, 8-bit) and its data.csv row.
   void AddImage(const std::string& camera, int64_t t_ns, const cv::Mat& image);
   // The two halves of AddImage: WriteImageFile is const and may run on several threads at once
@@ -53,7 +54,7 @@ class DatasetWriter {
 
  private:
   std::string root_;
-  std::unique_ptr<CsvWriter> imu_, depth_, dvl_, acoustic_, groundtruth_, visibility_, faults_;
+  std::unique_ptr<CsvWriter> imu_, depth_, dvl_, acoustic_, sbl_, groundtruth_, visibility_, faults_;
   std::unique_ptr<TumWriter> tum_;
   std::map<std::string, std::unique_ptr<CsvWriter>> cameras_;
   std::map<std::string, std::unique_ptr<CsvWriter>> rendered_lights_;

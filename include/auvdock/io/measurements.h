@@ -5,6 +5,8 @@
 //   DepthMeasurement  depth below the surface (m) of the pressure sensor.
 //   DvlMeasurement    velocity of the DVL over the ground in the DVL frame S (m/s).
 //   AcousticFix       position of the vehicle's transducer in D (m) and its reported 1-sigma.
+//   SblRange          short-baseline (SBL) slant range (m) from the dock's beacon to one of the
+//                     transducers on the hull (seed 001), and its reported 1-sigma.
 //   CameraFrame       one image: timestamp and file path (absolute, or relative to the
 //                     camera folder's data/ directory as written in data.csv).
 //   GroundTruthState  EuRoC state ground truth: T_D_B, v_D (m/s), gyro and accel biases.
@@ -46,6 +48,16 @@ struct AcousticFix {
   // on the dock and sent back: 0.2-1 s late). A causal estimator may use it from arrival_t_ns().
   int64_t latency_ns = 0;
   int64_t arrival_t_ns() const { return t_ns + latency_ns; }
+};
+
+// One slant range of a short-baseline ping: each transducer of the hull's array times the
+// beacon's reply on its own, so a ping gives up to one range per transducer (fewer when some
+// had no reply: no row for them).
+struct SblRange {
+  int64_t t_ns = 0;     // when the ping was measured (the vehicle measures it: no latency)
+  int transducer = 0;   // index into SblCalibration::p_B_transducers
+  double range_m = 0.0;
+  double sigma_m = 0.0;
 };
 
 struct CameraFrame {

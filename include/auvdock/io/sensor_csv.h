@@ -19,6 +19,7 @@ extern const char kCameraCsvHeader[];
 extern const char kDepthCsvHeader[];
 extern const char kDvlCsvHeader[];
 extern const char kAcousticCsvHeader[];
+extern const char kSblCsvHeader[];
 extern const char kGroundTruthCsvHeader[];
 extern const char kVisibilityCsvHeader[];
 extern const char kFaultsCsvHeader[];
@@ -38,6 +39,10 @@ std::vector<DvlMeasurement> ReadDvlCsv(const std::string& path,
                                        std::vector<std::string>* skipped = nullptr);
 std::vector<AcousticFix> ReadAcousticCsv(const std::string& path,
                                          std::vector<std::string>* skipped = nullptr);
+// SBL ranges, one row per transducer and ping: rows in strictly increasing (timestamp,
+// transducer) order (a ping's ranges share its timestamp); transducer in [0, num_transducers).
+std::vector<SblRange> ReadSblCsv(const std::string& path, int num_transducers,
+                                 std::vector<std::string>* skipped = nullptr);
 std::vector<GroundTruthState> ReadGroundTruthCsv(const std::string& path);
 std::vector<VisibilityRecord> ReadVisibilityCsv(const std::string& path);
 std::vector<FaultRecord> ReadFaultsCsv(const std::string& path);
@@ -47,6 +52,7 @@ std::string ImuCsvRow(const ImuSample& s);
 std::string DepthCsvRow(const DepthMeasurement& m);
 std::string DvlCsvRow(const DvlMeasurement& m);
 std::string AcousticCsvRow(const AcousticFix& m);
+std::string SblCsvRow(const SblRange& m);
 std::string GroundTruthCsvRow(const GroundTruthState& s);
 std::string VisibilityCsvRow(const VisibilityRecord& r);
 std::string FaultCsvRow(const FaultRecord& f);

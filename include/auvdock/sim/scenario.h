@@ -13,6 +13,7 @@
 #include "auvdock/geometry/dock_model.h"
 #include "auvdock/io/calibration.h"
 #include "auvdock/sim/acoustic_simulator.h"
+#include "auvdock/sim/sbl_simulator.h"
 #include "auvdock/sim/docking_trajectory.h"
 #include "auvdock/sim/dvl_simulator.h"
 #include "auvdock/sim/render_look.h"
@@ -66,6 +67,9 @@ struct Scenario {
   DvlFaultConfig dvl_faults;
   AcousticCalibration acoustic;
   AcousticFaultConfig acoustic_faults;
+  // A short-baseline array (scenario key `sbl:`), absent unless the scenario has one.
+  std::optional<SblCalibration> sbl;
+  SblFaultConfig sbl_faults;
 };
 
 // Reads a scenario file; the dock file it names is read relative to the scenario's folder.
@@ -77,7 +81,7 @@ Scenario LoadScenario(const std::string& path);
 Calibration MakeCalibration(const Scenario& scenario);
 
 // Multiplies every fault rate by factor (>= 0; probabilities clamped to 1): DVL spikes and
-// bias episodes, acoustic outliers, and the synthetic front-end's misses, spurious blobs and
+// bias episodes, acoustic and SBL outliers and SBL dropouts, and the synthetic front-end's misses, spurious blobs and
 // wrong ids (`simulate --fault-scale`, the Monte-Carlo audit's "several times the default").
 // The sizes of the faults and the image renderer's distractors are unchanged.
 void ScaleFaultRates(double factor, Scenario* scenario);
