@@ -73,6 +73,11 @@ std::vector<LightDetection> BlobLightDetector::Detect(const cv::Mat& image,
     candidate_options.min_response *= std::min(1.0, *clip / 255.0);
     score_response *= std::min(1.0, *clip / 255.0);
   }
+  // A threshold learned from the footage's lights (min_halo_excess) describes them at the
+  // ranges they were seen at; a light within decimetres of the lens whitens its own halo
+  // (saturated, blooming), so it is held to the permissive default only.
+  LightCandidateCheckOptions close_checks = checks;
+  close_checks.min_halo_excess = std::min(checks.min_halo_excess, options_.checks.min_halo_excess);
   std::vector<BlobCandidate> candidates = FindBlobCandidates(luma, candidate_options);
   std::stable_partition(candidates.begin(), candidates.end(), [&](const BlobCandidate& c) {
     return c.sigma_px <= options_.close_light_min_sigma_px;
@@ -89,14 +94,7 @@ std::vector<LightDetection> BlobLightDetector::Detect(const cv::Mat& image,
       continue;
     }
     const bool close_light = candidate.sigma_px > options_.close_light_min_sigma_px;
-    // A threshold learned from the footage's lights (min_halo_excess) describes them at the
-    // ranges they were seen at; a light within decimetres of the lens whitens its own halo
-    // (saturated, blooming), so it is held to the permissive default only.
-    LightCandidateCheckOptions candidate_checks = checks;
-    if (close_light) {
-      candidate_checks.min_halo_excess =
-          std::min(checks.min_halo_excess, options_.checks.min_halo_excess);
-    }
+    const LightCandidateCheckOptions& candidate_checks = close_light ? close_checks : checks;
     const LightCandidateEvidence evidence = MeasureCandidateEvidence(
         source, luma, *core, candidate.sigma_px, background_excess, candidate_checks);
     const std::string reason =
