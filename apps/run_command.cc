@@ -49,8 +49,7 @@ void Run(const RunOptions& options) {
   SlidingWindowEstimator estimator(dataset.calibration, RequireDock(dataset), config.estimator);
   GoNoGo go_no_go(config.go_no_go);
   EstimateWriter writer(options.out, options.euroc_csv);
-  for (const std::string& row : skipped_rows)
-    std::fprintf(stderr, "auvdock: run: %s\n", row.c_str());
+  PrintSkippedRows("run", skipped_rows);
 
   const CancellationToken cancel = InstallSignalCancellation();
   RunCounters counters;

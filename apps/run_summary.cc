@@ -73,6 +73,17 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
   return summary;
 }
 
+void PrintSkippedRows(const char* command, const std::vector<std::string>& skipped_rows,
+                      std::size_t max_lines) {
+  for (std::size_t i = 0; i < skipped_rows.size() && i < max_lines; ++i) {
+    std::fprintf(stderr, "auvdock: %s: %s\n", command, skipped_rows[i].c_str());
+  }
+  if (skipped_rows.size() > max_lines) {
+    std::fprintf(stderr, "auvdock: %s: ... and %zu more rows skipped (summary.json \"log\" lists them)\n",
+                 command, skipped_rows.size() - max_lines);
+  }
+}
+
 void PrintSymmetryUnresolved(const char* command, int count) {
   if (count == 0) return;
   std::printf("  %s: %d estimates are known only up to the dock's symmetry: nothing told its "

@@ -26,6 +26,12 @@ struct RunCounters {
   bool interrupted = false;
 };
 
+// The dataset's skipped rows on stderr ("auvdock: COMMAND: ..."), the first max_lines of them
+// and then how many more: a stream that runs backwards skips every row until it is past its
+// last time again, hundreds of lines that would bury the rest. summary.json's "log" has all.
+void PrintSkippedRows(const char* command, const std::vector<std::string>& skipped_rows,
+                      std::size_t max_lines = 10);
+
 // One line on stdout when some estimates are known only up to the dock's symmetry.
 void PrintSymmetryUnresolved(const char* command, int count);
 

@@ -45,6 +45,7 @@ void Smooth(const SmoothOptions& options) {
   std::vector<std::string> skipped_rows;
   const Dataset dataset = LoadDatasetWithDock(options.dataset, options.dock, &skipped_rows);
   if (!dataset.calibration.imu) throw InputError(options.dataset + ": calibration has no IMU");
+  PrintSkippedRows("smooth", skipped_rows);
   VisionFrameSource source(dataset, options.frames);
   SlidingWindowEstimator estimator(dataset.calibration, RequireDock(dataset), config.estimator);
   EstimateWriter writer(options.out, options.euroc_csv);

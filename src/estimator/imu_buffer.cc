@@ -9,7 +9,9 @@ namespace auvdock {
 
 ImuBuffer::ImuBuffer(const ImuCalibration& calibration, double max_gap_s, double noise_scale)
     : noise_(ImuNoiseDensities::FromCalibration(calibration)),
-      max_gap_ns_(static_cast<int64_t>(max_gap_s * 1e9)) {
+      max_gap_ns_(static_cast<int64_t>(max_gap_s * 1e9)),
+      gyroscope_range_(calibration.gyroscope_range),
+      accelerometer_range_(calibration.accelerometer_range) {
   if (!(max_gap_s > 0.0)) throw std::invalid_argument("ImuBuffer: max_gap_s must be positive");
   if (!(noise_scale > 0.0) || !std::isfinite(noise_scale)) {
     throw std::invalid_argument("ImuBuffer: noise_scale must be positive");
@@ -22,6 +24,12 @@ ImuBuffer::ImuBuffer(const ImuCalibration& calibration, double max_gap_s, double
 
 std::string ImuBuffer::Add(const ImuSample& sample) {
   if (!sample.gyro.allFinite() || !sample.accel.allFinite()) return "not finite";
+  if (sample.gyro.cwiseAbs().maxCoeff() > gyroscope_range_) {
+    return "beyond the gyroscope's range (" + std::to_string(gyroscope_range_) + " rad/s)";
+  }
+  if (sample.accel.cwiseAbs().maxCoeff() > accelerometer_range_) {
+    return "beyond the accelerometer's range (" + std::to_string(accelerometer_range_) + " m/s^2)";
+  }
   if (!samples_.empty() && sample.t_ns <= samples_.back().t_ns) return "out of order or repeated";
   samples_.push_back(sample);
   return "";

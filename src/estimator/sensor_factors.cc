@@ -4,6 +4,8 @@
 #include <memory>
 #include <utility>
 
+#include <ceres/loss_function.h>
+
 #include "factors/depth_factor.h"
 #include "factors/dvl_factor.h"
 #include "factors/time_shifted_factor.h"
@@ -11,13 +13,22 @@
 #include "factors/usbl_fix_factor.h"
 
 namespace auvdock {
+namespace {
+
+// A Huber loss at huber_sigmas on the whitened norm; none (plain least squares) at +infinity.
+ceres::LossFunction* HuberOrNone(double huber_sigmas) {
+  return std::isinf(huber_sigmas) ? nullptr : new ceres::HuberLoss(huber_sigmas);
+}
+
+}  // namespace
 
 std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
                                                      const DepthMeasurement& sample,
                                                      const DepthCalibration& calibration,
                                                      const DockModel& dock,
                                                      const StateBlocks& state, int64_t t_state_ns,
-                                                     double variance_factor) {
+                                                     double variance_factor,
+                                                     double huber_sigmas) {
   if (!std::isfinite(sample.depth_m) || sample.t_ns < t_state_ns) return std::nullopt;
   const std::optional<ImuPoseShift> shift =
       ImuShiftFromState(state, t_state_ns, sample.t_ns - t_state_ns, dock.gravity_D);
@@ -26,7 +37,7 @@ std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
       problem,
       std::make_unique<DepthFactor>(sample.depth_m, calibration.sigma_m * std::sqrt(variance_factor),
                                     dock.origin_depth_m, dock.gravity_D, calibration.T_B_S.p),
-      *shift, nullptr, state);
+      *shift, HuberOrNone(huber_sigmas), state);
 }
 
 std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
@@ -35,7 +46,7 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
                                                    const DockModel& dock,
                                                    const StateBlocks& state, int64_t t_state_ns,
                                                    const ImuPoseShift* shift,
-                                                   double variance_factor) {
+                                                   double variance_factor, double huber_sigmas) {
   if (!sample.v_S.allFinite() || sample.t_ns < t_state_ns || state.imu == nullptr ||
       state.velocity == nullptr) {
     return std::nullopt;
@@ -50,14 +61,15 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
       DvlFactor::Create(sample.v_S, calibration.sigma_mps * std::sqrt(variance_factor),
                         calibration.T_B_S,
                         *gyro - state.bias.gyro, *own_shift),
-      nullptr, state.pose, state.velocity);
+      HuberOrNone(huber_sigmas), state.pose, state.velocity);
 }
 
 std::optional<ceres::ResidualBlockId> AddUsblFactor(ceres::Problem* problem,
                                                     const AcousticFix& fix,
                                                     const AcousticCalibration& calibration,
                                                     const DockModel& dock,
-                                                    const StateBlocks& state, int64_t t_state_ns) {
+                                                    const StateBlocks& state, int64_t t_state_ns,
+                                                    double huber_sigmas) {
   // A fix from before the state (it arrived late) is shifted backward through the IMU.
   if (!fix.p_D.allFinite() || !std::isfinite(fix.sigma_m) || !(fix.sigma_m > 0.0)) {
     return std::nullopt;
@@ -67,14 +79,15 @@ std::optional<ceres::ResidualBlockId> AddUsblFactor(ceres::Problem* problem,
   if (!shift) return std::nullopt;
   return AddOnState<UsblFixFactor, kUsblResidualSize>(
       problem, std::make_unique<UsblFixFactor>(fix.p_D, fix.sigma_m, calibration.T_B_S.p), *shift,
-      nullptr, state);
+      HuberOrNone(huber_sigmas), state);
 }
 
 std::optional<ceres::ResidualBlockId> AddSblFactor(ceres::Problem* problem,
                                                    const SblRange& range,
                                                    const SblCalibration& calibration,
                                                    const DockModel& dock,
-                                                   const StateBlocks& state, int64_t t_state_ns) {
+                                                   const StateBlocks& state, int64_t t_state_ns,
+                                                   double huber_sigmas) {
   if (range.transducer < 0 ||
       range.transducer >= static_cast<int>(calibration.p_B_transducers.size()) ||
       !std::isfinite(range.range_m) || range.range_m < 0.0 || !std::isfinite(range.sigma_m) ||
@@ -89,7 +102,7 @@ std::optional<ceres::ResidualBlockId> AddSblFactor(ceres::Problem* problem,
       std::make_unique<SblRangeFactor>(range.range_m, range.sigma_m,
                                        calibration.p_B_transducers[range.transducer],
                                        dock.p_D_beacon),
-      *shift, nullptr, state);
+      *shift, HuberOrNone(huber_sigmas), state);
 }
 
 std::string ImplausibleDepth(const DepthMeasurement& sample) {

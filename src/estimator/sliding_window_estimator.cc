@@ -303,7 +303,8 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachSbl(int64_t t_ns) {
   return AttachPending(&pending_sbl_, t_ns, calibration_.sbl->name, &stats_.sbl_skipped,
                        [&](const SblRange& range, State& state) {
                          return AddSblFactor(problem_.get(), range, *calibration_.sbl, dock_,
-                                             BlocksOf(state), state.t_ns);
+                                             BlocksOf(state), state.t_ns,
+                                             options_.vision.huber_sigmas);
                        });
 }
 
@@ -311,7 +312,8 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachUsbl(int64_t t_ns) {
   return AttachPending(&pending_usbl_, t_ns, calibration_.acoustic->name, &stats_.usbl_skipped,
                        [&](const AcousticFix& fix, State& state) {
                          return AddUsblFactor(problem_.get(), fix, *calibration_.acoustic, dock_,
-                                              BlocksOf(state), state.t_ns);
+                                              BlocksOf(state), state.t_ns,
+                                              options_.vision.huber_sigmas);
                        },
                        options_.usbl_max_backward_shift_s);
 }
@@ -378,8 +380,8 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDepth(int64_t t_ns) {
   return AttachPending(&pending_depth_, t_ns, calibration_.depth->name, &stats_.depth_skipped,
                        [&](const DepthMeasurement& sample, State& state) {
                          return AddDepthFactor(problem_.get(), sample, *calibration_.depth, dock_,
-                                               BlocksOf(state),
-                                              state.t_ns, depth_noise_.factor());
+                                               BlocksOf(state), state.t_ns, depth_noise_.factor(),
+                                               options_.vision.huber_sigmas);
                        });
 }
 
@@ -411,7 +413,8 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
       }
       // The shift is the one the rate test used: the IMU is preintegrated once per sample.
       id = AddDvlFactor(problem_.get(), sample, *calibration_.dvl, dock_, blocks, state->t_ns,
-                        shift ? &*shift : nullptr, dvl_noise_.factor());
+                        shift ? &*shift : nullptr, dvl_noise_.factor(),
+                        options_.vision.huber_sigmas);
     }
     if (id) {
       added.push_back({*id, sample.t_ns});
@@ -486,8 +489,14 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   if (window_.empty()) {
     if (!Initialize(frame)) return std::nullopt;
   } else if (!AddState(frame.t_ns)) {
-    Reset("no IMU coverage (gap longer than " + std::to_string(options_.max_imu_gap_s) +
-          " s) up to " + std::to_string(frame.t_ns) + " ns");
+    // One reset per outage: while no IMU sample has come since the last reset for a gap, the
+    // window restarts at each frame of the outage without counting it again.
+    const bool same_outage = imu_.newest_t_ns() == imu_outage_newest_t_ns_;
+    Reset(same_outage ? std::string()
+                      : "no IMU coverage (gap longer than " +
+                            std::to_string(options_.max_imu_gap_s) + " s) up to " +
+                            std::to_string(frame.t_ns) + " ns");
+    imu_outage_newest_t_ns_ = imu_.newest_t_ns();
     if (!Initialize(frame)) return std::nullopt;
   }
   State* state = window_.back().get();

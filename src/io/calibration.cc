@@ -89,6 +89,8 @@ Calibration LoadCalibration(const std::string& path) {
     imu.gyroscope_random_walk = n.GetPositive("gyroscope_random_walk");
     imu.accelerometer_noise_density = n.GetPositive("accelerometer_noise_density");
     imu.accelerometer_random_walk = n.GetPositive("accelerometer_random_walk");
+    imu.gyroscope_range = n.GetPositive("gyroscope_range", imu.gyroscope_range);
+    imu.accelerometer_range = n.GetPositive("accelerometer_range", imu.accelerometer_range);
     calibration.imu = imu;
   }
   if (root.Has("depth")) {
@@ -171,6 +173,8 @@ void SaveCalibration(const Calibration& calibration, const std::string& path) {
     EmitNumber(out, "gyroscope_random_walk", imu.gyroscope_random_walk);
     EmitNumber(out, "accelerometer_noise_density", imu.accelerometer_noise_density);
     EmitNumber(out, "accelerometer_random_walk", imu.accelerometer_random_walk);
+    EmitNumber(out, "gyroscope_range", imu.gyroscope_range);
+    EmitNumber(out, "accelerometer_range", imu.accelerometer_range);
     EmitTransform(out, "T_B_S", imu.T_B_S);
     out << YAML::EndMap;
   }

@@ -27,6 +27,8 @@ const char kFaultsCsvHeader[] = "#timestamp [ns],sensor,kind,detail";
 namespace {
 
 constexpr int64_t kNoTime = std::numeric_limits<int64_t>::min();
+// An IMU time stamp this much before the previous one is a clock jump, not jitter.
+constexpr int64_t kImuClockJumpBackNs = 100'000'000;
 
 std::string Join(int64_t t_ns, std::initializer_list<double> values) {
   std::string line = std::to_string(t_ns);
@@ -74,6 +76,22 @@ std::vector<ImuSample> ReadImuCsv(const std::string& path, std::vector<std::stri
   std::vector<ImuSample> samples;
   int64_t previous = kNoTime;
   while (reader.Next()) {
+    // A clock that jumps back (more than jitter): the rows after it carry times that are not
+    // the times of the motion they measured, and integrating them as if they were drags the
+    // estimate away while it looks sure of itself. Lenient mode skips the rest of the file (an
+    // IMU outage: the estimator resets and goes on from vision).
+    if (skipped != nullptr && previous != kNoTime &&
+        previous - reader.Int64(0) > kImuClockJumpBackNs) {
+      const double jump_s = static_cast<double>(previous - reader.Int64(0)) * 1e-9;
+      const int line = reader.line();
+      int rest = 0;
+      while (reader.Next()) ++rest;
+      skipped->push_back(reader.path() + ": line " + std::to_string(line) +
+                         ": the clock jumped back by " + FormatDouble(jump_s) +
+                         " s: this and the " + std::to_string(rest) +
+                         " rows after it skipped (their times are not those of the motion)");
+      break;
+    }
     if (SkipRow(reader, 6, &previous, skipped)) continue;
     ImuSample s;
     s.t_ns = ReadTime(reader, &previous);

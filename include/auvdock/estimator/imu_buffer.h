@@ -25,8 +25,8 @@ class ImuBuffer {
   // imu_noise_scale).
   ImuBuffer(const ImuCalibration& calibration, double max_gap_s, double noise_scale = 1.0);
 
-  // Appends a sample; returns an empty string, or why it was skipped (not finite, not after the
-  // previous sample).
+  // Appends a sample; returns an empty string, or why it was skipped (not finite, beyond the
+  // calibration's gyroscope or accelerometer range on an axis, not after the previous sample).
   std::string Add(const ImuSample& sample);
 
   // Preintegration over [t0_ns, t1_ns] at the linearisation bias; nothing when the interval is
@@ -51,6 +51,8 @@ class ImuBuffer {
  private:
   ImuNoiseDensities noise_;
   int64_t max_gap_ns_;
+  double gyroscope_range_;      // rad/s, per axis
+  double accelerometer_range_;  // m/s^2, per axis
   std::deque<ImuSample> samples_;
 };
 

@@ -4,8 +4,11 @@
 // A sample at time t attaches to the latest state at or before t (t_k): at t = t_k directly on
 // the state's blocks; later, through the IMU's motion over t - t_k (ImuPoseShift,
 // factors/time_shifted_factor.h), so every sample is used at its own time whatever the
-// sensor's rate and clock, without a state of its own. No robust loss: a residual beyond its
-// chi-square gate after a solve is removed instead, and counted.
+// sensor's rate and clock, without a state of its own. A residual beyond its chi-square gate
+// after a solve is removed, and counted; the sliding window also gives each a Huber loss
+// (huber_sigmas on the whitened norm, as its lights), so that one absurd sample (a depth of
+// 1e9 m) cannot drag the window so far before its gate that every light is gated with it. The
+// batch smoother, which gates with every measurement in, uses none (+infinity).
 //   depth  factors/depth_factor.h  1 residual, on the pose (and the velocity when shifted)
 //   DVL    factors/dvl_factor.h    3 residuals, on the pose and the velocity; the body rate from
 //                                  the gyro held at t minus the state's gyro bias
@@ -16,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,6 +34,9 @@
 
 namespace auvdock {
 
+// huber_sigmas of a factor without a robust loss.
+inline constexpr double kNoRobustLoss = std::numeric_limits<double>::infinity();
+
 // The sample's residual on `state` (whose time is t_state_ns <= sample.t_ns); nothing when the
 // sample is not finite or the IMU does not reach its time.
 // variance_factor multiplies the configured variance (the adaptive estimate of the sensor's
@@ -39,7 +46,8 @@ std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
                                                      const DepthCalibration& calibration,
                                                      const DockModel& dock,
                                                      const StateBlocks& state, int64_t t_state_ns,
-                                                     double variance_factor = 1.0);
+                                                     double variance_factor = 1.0,
+                                                     double huber_sigmas = kNoRobustLoss);
 
 // The same for a DVL sample; nothing also when the IMU has no gyro sample at its time. A sample
 // that is not finite (bottom lock lost) is no measurement.
@@ -52,7 +60,8 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
                                                    const DockModel& dock,
                                                    const StateBlocks& state, int64_t t_state_ns,
                                                    const ImuPoseShift* shift = nullptr,
-                                                   double variance_factor = 1.0);
+                                                   double variance_factor = 1.0,
+                                                   double huber_sigmas = kNoRobustLoss);
 
 // The same for an acoustic (USBL) fix of the transponder; nothing also when its sigma is not
 // positive and finite. A fix may also be earlier than the state (it arrived after its time left
@@ -61,7 +70,8 @@ std::optional<ceres::ResidualBlockId> AddUsblFactor(ceres::Problem* problem,
                                                     const AcousticFix& fix,
                                                     const AcousticCalibration& calibration,
                                                     const DockModel& dock,
-                                                    const StateBlocks& state, int64_t t_state_ns);
+                                                    const StateBlocks& state, int64_t t_state_ns,
+                                                    double huber_sigmas = kNoRobustLoss);
 
 // The same for one SBL range (the beacon at dock.p_D_beacon); nothing also when its transducer
 // is not in the calibration or its sigma is not positive and finite.
@@ -69,7 +79,8 @@ std::optional<ceres::ResidualBlockId> AddSblFactor(ceres::Problem* problem,
                                                    const SblRange& range,
                                                    const SblCalibration& calibration,
                                                    const DockModel& dock,
-                                                   const StateBlocks& state, int64_t t_state_ns);
+                                                   const StateBlocks& state, int64_t t_state_ns,
+                                                   double huber_sigmas = kNoRobustLoss);
 
 // Why a sample cannot be a measurement whatever the state (empty when it can): a depth above
 // the surface by more than 0.5 m (a pressure sensor reads slightly negative at the surface, a

@@ -29,7 +29,8 @@
 // tilt disagrees with the accelerometer (init_max_tilt_error_rad). The attitude then refines
 // against gravity through the IMU factors (gravity_D is the dock's, not a constant).
 // Reset: an IMU gap longer than max_imu_gap_s, or a failed solve, drops the window and waits
-// for the next per-frame pose; every reset is counted and logged.
+// for the next per-frame pose; every reset is counted and logged, an IMU outage once however
+// many frames it lasts (the window restarts at each of them without a count).
 //
 // Causality: a frame's output uses only the IMU samples up to its timestamp (the last sample is
 // held to the frame time) and frames up to it.
@@ -345,6 +346,7 @@ class SlidingWindowEstimator {
   int64_t first_state_t_ns_ = INT64_MIN;  // since the last initialisation
   int64_t last_vision_t_ns_ = INT64_MIN;
   bool symmetry_unresolved_ = false;  // of the window's first pose (EstimatorOutput)
+  std::optional<int64_t> imu_outage_newest_t_ns_;  // the newest IMU sample at the last gap reset
   int64_t last_dvl_t_ns_ = INT64_MIN;
   std::string init_refusal_;
   EstimatorStats stats_;

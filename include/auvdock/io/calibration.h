@@ -22,6 +22,11 @@ struct ImuCalibration {
   double gyroscope_random_walk = 3.9e-5;        // rad/s^2/sqrt(Hz)
   double accelerometer_noise_density = 4.0e-3;  // m/s^2/sqrt(Hz)
   double accelerometer_random_walk = 6.0e-3;    // m/s^3/sqrt(Hz)
+  // Full scale per axis: a reading beyond it is no measurement (a corrupt sample, a driver
+  // error) and is skipped. Defaults: +-2000 deg/s and +-16 g, the widest ranges of common MEMS
+  // IMUs; set the sensor's own (calibration.yaml imu: gyroscope_range, accelerometer_range).
+  double gyroscope_range = 34.9;        // rad/s
+  double accelerometer_range = 156.9;   // m/s^2
 };
 
 struct DepthCalibration {

@@ -28,6 +28,8 @@ extern const char kFaultsCsvHeader[];
 // is an InputError naming the file and line. With `skipped` given, such a row is left out and
 // described there instead ("imu0/data.csv: line 17: NaN/Inf: row skipped"), so that a run can
 // go on past a bad measurement; malformed text is an error either way.
+// The IMU's clock jumping back by more than 0.1 s ends its file in lenient mode: that row and
+// every later one are skipped, in one line (their times are not those of the motion).
 std::vector<ImuSample> ReadImuCsv(const std::string& path,
                                   std::vector<std::string>* skipped = nullptr);
 // Camera frames; each path is made absolute as <image_dir>/<filename>.
