@@ -1,5 +1,8 @@
 #include "apps/camera_image.h"
 
+#include <filesystem>
+#include <system_error>
+
 #include <opencv2/imgcodecs.hpp>
 
 namespace auvdock::cli {
@@ -7,6 +10,11 @@ namespace auvdock::cli {
 cv::Mat ReadCameraImage(const CameraFrame& frame, const CameraCalibration& camera,
                         std::string* problem) {
   problem->clear();
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(frame.path, error)) {
+    *problem = "missing (listed in the camera's data.csv, not in its data/ folder)";
+    return cv::Mat();
+  }
   cv::Mat image = cv::imread(frame.path, cv::IMREAD_COLOR);
   if (image.empty()) {
     *problem = "cannot decode";

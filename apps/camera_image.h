@@ -10,8 +10,8 @@
 
 namespace auvdock::cli {
 
-// The image of `frame`; an empty one and `problem` set ("cannot decode", "is WxH, calibration
-// says W'xH'") when it cannot be used.
+// The image of `frame`; an empty one and `problem` set ("missing ...", "cannot decode", "is
+// WxH, calibration says W'xH'") when it cannot be used.
 cv::Mat ReadCameraImage(const CameraFrame& frame, const CameraCalibration& camera,
                         std::string* problem);
 

@@ -113,8 +113,8 @@ TEST_F(EstimatorCli, RunAndSmoothWriteEveryFileAndTheFilesEvaluate) {
   }
 }
 
-// A corrupt image, an IMU row with NaN and a repeated IMU timestamp: the run goes on, skips
-// them, says so in summary.json and its log, and writes no NaN pose.
+// A corrupt image, a missing one, an IMU row with NaN and a repeated IMU timestamp: the run goes
+// on, skips them, says so in summary.json and its log, and writes no NaN pose.
 TEST_F(EstimatorCli, RunSkipsBadMeasurementsAndCountsThem) {
   const std::string ds = *tmp_ / "bad_ds";
   fs::copy(dataset_, ds, fs::copy_options::recursive);
@@ -124,6 +124,7 @@ TEST_F(EstimatorCli, RunSkipsBadMeasurementsAndCountsThem) {
   std::sort(images.begin(), images.end());
   ASSERT_GT(images.size(), 20u);
   test::WriteTextFile(images[15].string(), "not a png");
+  fs::remove(images[25]);  // listed in data.csv, gone from data/
 
   const std::string imu_path = ds + "/imu0/data.csv";
   std::vector<std::string> lines;
@@ -143,9 +144,10 @@ TEST_F(EstimatorCli, RunSkipsBadMeasurementsAndCountsThem) {
   const std::string out = *tmp_ / "bad_out";
   const auto r = test::RunAuvdock({"run", "--dataset", ds, "--out", out, "--quiet"});
   ASSERT_EQ(r.exit_status, 0) << r.err;
-  EXPECT_THAT(r.err, AllOf(HasSubstr("image skipped"), HasSubstr("imu0/data.csv")));
+  EXPECT_THAT(r.err, AllOf(HasSubstr("image skipped"), HasSubstr("imu0/data.csv"),
+                           HasSubstr(images[25].filename().string() + ": missing")));
   const nlohmann::json summary = Summary(out);
-  EXPECT_EQ(summary.at("unreadable_images").get<int>(), 1);
+  EXPECT_EQ(summary.at("unreadable_images").get<int>(), 2);
   EXPECT_EQ(summary.at("skipped").at("dataset_rows").get<int>(), 2);
   const Trajectory poses = ReadTumTrajectory(out + "/trajectory.tum");
   EXPECT_GE(poses.size(), 25u);
