@@ -41,6 +41,7 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                            {"skipped", stats.usbl_skipped}};
   summary["sbl_ranges"] = {{"used", stats.sbl_used},
                            {"gated", stats.sbl_gated},
+                           {"rate_test_rejected", stats.sbl_rate_rejected},
                            {"skipped", stats.sbl_skipped}};
   summary["no_vision_reasons"] = source.no_vision_reasons();
   if (source.replaying()) {

@@ -33,6 +33,8 @@ RunConfig LoadRunConfig(const std::string& path) {
       est.GetNonNegative("usbl_max_backward_shift_s", e.usbl_max_backward_shift_s);
   e.use_sbl = est.GetBool("use_sbl", e.use_sbl);
   e.sbl_gate_chi2 = est.GetNonNegative("sbl_gate_chi2", e.sbl_gate_chi2);
+  e.sbl_rate_test = est.GetBool("sbl_rate_test", e.sbl_rate_test);
+  e.sensor_huber_sigmas = est.GetPositive("sensor_huber_sigmas", e.sensor_huber_sigmas);
   e.dvl_rate_test.enabled = est.GetBool("dvl_rate_test", e.dvl_rate_test.enabled);
   e.dvl_rate_test.gate_chi2 = est.GetPositive("dvl_rate_gate_chi2", e.dvl_rate_test.gate_chi2);
   e.dvl_rate_test.accel_sigma_mps2 =

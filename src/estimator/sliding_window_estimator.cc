@@ -52,6 +52,11 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
       dvl_noise_(options.adaptive_dvl_noise),
       depth_noise_(options.adaptive_depth_noise),
       usbl_rate_test_(options.usbl_rate_test) {
+  if (calibration_.sbl) {
+    UsblRateTestOptions sbl_rate = options.usbl_rate_test;
+    sbl_rate.enabled = options.sbl_rate_test;
+    sbl_rate_tests_.assign(calibration_.sbl->p_B_transducers.size(), UsblRateTest(sbl_rate));
+  }
   if (options_.window_size < 2 || options_.max_solver_iterations < 1 ||
       !(options_.vision.huber_sigmas > 0.0) || !(options_.max_imu_gap_s > 0.0) ||
       options_.mono_gate_chi2 < 0.0 || options_.stereo_gate_chi2 < 0.0 ||
@@ -87,6 +92,7 @@ void SlidingWindowEstimator::Reset(const std::string& reason) {
   window_.clear();
   symmetry_unresolved_ = false;
   dvl_rate_test_.Reset();
+  sbl_transducer_of_.clear();
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_options.enable_fast_removal = true;
@@ -295,6 +301,14 @@ void SlidingWindowEstimator::AddSblRange(const SblRange& range) {
   }
   last_sbl_sample_t_ns_ = range.t_ns;
   last_sbl_transducer_ = range.transducer;
+  const UsblRateVerdict verdict = sbl_rate_tests_[range.transducer].Check(range);
+  if (!verdict.pass) {
+    ++stats_.sbl_rate_rejected;
+    rejections_.push_back({range.t_ns, calibration_.sbl->name, verdict.excess,
+                           "transducer " + std::to_string(range.transducer) + ": " +
+                               verdict.reason});
+    return;
+  }
   pending_sbl_.push_back(range);
 }
 
@@ -302,9 +316,12 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachSbl(int64_t t_ns) {
   if (!calibration_.sbl) return {};
   return AttachPending(&pending_sbl_, t_ns, calibration_.sbl->name, &stats_.sbl_skipped,
                        [&](const SblRange& range, State& state) {
-                         return AddSblFactor(problem_.get(), range, *calibration_.sbl, dock_,
-                                             BlocksOf(state), state.t_ns,
-                                             options_.vision.huber_sigmas);
+                         const std::optional<ceres::ResidualBlockId> id =
+                             AddSblFactor(problem_.get(), range, *calibration_.sbl, dock_,
+                                          BlocksOf(state), state.t_ns,
+                                          options_.sensor_huber_sigmas);
+                         if (id) sbl_transducer_of_[*id] = range.transducer;
+                         return id;
                        });
 }
 
@@ -313,7 +330,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachUsbl(int64_t t_ns) {
                        [&](const AcousticFix& fix, State& state) {
                          return AddUsblFactor(problem_.get(), fix, *calibration_.acoustic, dock_,
                                               BlocksOf(state), state.t_ns,
-                                              options_.vision.huber_sigmas);
+                                              options_.sensor_huber_sigmas);
                        },
                        options_.usbl_max_backward_shift_s);
 }
@@ -381,7 +398,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDepth(int64_t t_ns) {
                        [&](const DepthMeasurement& sample, State& state) {
                          return AddDepthFactor(problem_.get(), sample, *calibration_.depth, dock_,
                                                BlocksOf(state), state.t_ns, depth_noise_.factor(),
-                                               options_.vision.huber_sigmas);
+                                               options_.sensor_huber_sigmas);
                        });
 }
 
@@ -414,7 +431,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
       // The shift is the one the rate test used: the IMU is preintegrated once per sample.
       id = AddDvlFactor(problem_.get(), sample, *calibration_.dvl, dock_, blocks, state->t_ns,
                         shift ? &*shift : nullptr, dvl_noise_.factor(),
-                        options_.vision.huber_sigmas);
+                        options_.sensor_huber_sigmas);
     }
     if (id) {
       added.push_back({*id, sample.t_ns});
@@ -542,6 +559,10 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   const int sbl_gated = gate(&sbl, options_.sbl_gate_chi2, calibration_.sbl, &stats_.sbl_gated,
                              &stats_.sbl_used);
   for (const SensorResidual& kept : usbl) usbl_rate_test_.Confirm(kept.t_ns);
+  for (const SensorResidual& kept : sbl) {
+    sbl_rate_tests_[sbl_transducer_of_.at(kept.id)].Confirm(kept.t_ns);
+  }
+  sbl_transducer_of_.clear();
   for (const SensorResidual& kept : dvl) {
     dvl_rate_test_.Confirm(kept.t_ns);
     last_dvl_t_ns_ = std::max(last_dvl_t_ns_, kept.t_ns);

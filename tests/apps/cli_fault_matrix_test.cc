@@ -284,17 +284,15 @@ TEST_F(FaultMatrix, AnImuClockThatJumpsBackEndsTheImuStream) {
   EXPECT_EQ(summary.at("skipped").at("dataset_rows").get<int>(), 1);
 }
 
-// The cameras see nothing from 2 s to 10 s of the 12 s (each image listed as "saw nothing").
-TEST_F(FaultMatrix, CamerasThatSeeNothingForMostOfTheRun) {
-  const std::string ds = Copy("blind");
-  const std::string file = ds + "/detections.csv";
-  const std::vector<std::string> lines = Lines(test::ReadTextFile(file));
+// Every image of the cameras from t0 + from_s to t0 + to_s listed as "saw nothing".
+void BlindTheCameras(const std::string& detections_file, double from_s, double to_s) {
+  const std::vector<std::string> lines = Lines(test::ReadTextFile(detections_file));
   const int64_t t0 = TimeOf(lines[1]);
   std::string text = lines[0] + "\n";
   std::string last_blind;
   for (std::size_t i = 1; i < lines.size(); ++i) {
     const int64_t t = TimeOf(lines[i]);
-    if (t < t0 + 2'000'000'000 || t > t0 + 10'000'000'000) {
+    if (t < t0 + static_cast<int64_t>(from_s * 1e9) || t > t0 + static_cast<int64_t>(to_s * 1e9)) {
       text += lines[i] + "\n";
       continue;
     }
@@ -303,12 +301,40 @@ TEST_F(FaultMatrix, CamerasThatSeeNothingForMostOfTheRun) {
     if (blind != last_blind) text += blind + "\n";
     last_blind = blind;
   }
-  test::WriteTextFile(file, text);
+  test::WriteTextFile(detections_file, text);
+}
+
+// The cameras see nothing from 2 s to 10 s of the 12 s.
+TEST_F(FaultMatrix, CamerasThatSeeNothingForMostOfTheRun) {
+  const std::string ds = Copy("blind");
+  BlindTheCameras(ds + "/detections.csv", 2.0, 10.0);
   for (const char* command : {"run", "smooth"}) {
     const RunOutcome run = RunOn(command, ds, ds + "/out_" + command);
     ExpectWentOn(run, dataset_, std::string("blind cameras (") + command + ")");
     // Every frame is still a frame: one decision each (NO-GO with a reason while blind).
     EXPECT_EQ(ReadDecisionsCsv(run.out + "/decisions.csv").size(), 121u) << command;
+  }
+}
+
+// The whole default scenario (40 s), the cameras blind from 2 s to 38 s: the DVL carries the
+// estimate, GO for at most max_aided_vision_age_s (10 s) of it, then NO-GO until the lights.
+TEST_F(FaultMatrix, CamerasBlindForHalfAMinute) {
+  const std::string ds = *tmp_ / "blind40";
+  const auto s = test::RunAuvdock({"simulate", "--scenario",
+                                   test::SourcePath("data/scenarios/default.yaml"), "--out", ds,
+                                   "--detections-only", "--quiet"});
+  ASSERT_EQ(s.exit_status, 0) << s.err;
+  const std::string truth = *tmp_ / "blind40_truth";
+  fs::copy(ds, truth, fs::copy_options::recursive);
+  BlindTheCameras(ds + "/detections.csv", 2.0, 38.0);
+  for (const char* command : {"run", "smooth"}) {
+    const RunOutcome run = RunOn(command, ds, ds + "/out_" + command);
+    ExpectWentOn(run, truth, std::string("blind 36 s (") + command + ")");
+    int no_vision = 0;
+    for (const StampedDecision& d : ReadDecisionsCsv(run.out + "/decisions.csv")) {
+      no_vision += !d.go && d.reason.find("no vision for") != std::string::npos;
+    }
+    EXPECT_GT(no_vision, 200) << command;  // 36 s less the DVL-aided 10 s, at 10 frames/s
   }
 }
 

@@ -66,5 +66,31 @@ TEST(UsblRateTest, AnOldReferenceIsDroppedAndAnUnconfirmedCandidateIsNot) {
   EXPECT_TRUE(disabled.Check(Fix(1.0, 10.0)).pass);
 }
 
+SblRange Range(double t_s, double range_m, double sigma = 0.05) {
+  SblRange r;
+  r.t_ns = static_cast<int64_t>(t_s * 1e9);
+  r.transducer = 2;
+  r.range_m = range_m;
+  r.sigma_m = sigma;
+  return r;
+}
+
+// One transducer's slant ranges at 0.5 m/s of closing speed, then a multipath reply 2.4 m long
+// (1.9 m of change in 1 s, 1.5 m/s allowed): it fails with its own reason, the next direct
+// reply passes against the last good range.
+TEST(UsblRateTest, ARangeThatGrowsFasterThanTheVehicleFails) {
+  UsblRateTest test;
+  EXPECT_TRUE(test.Check(Range(0.0, 9.0)).pass);
+  test.Confirm(Range(0.0, 9.0).t_ns);
+  const UsblRateVerdict good = test.Check(Range(1.0, 8.5));
+  EXPECT_TRUE(good.pass);
+  EXPECT_NEAR(good.excess, (0.5 - 1.5) / (0.05 * std::sqrt(2.0)), 1e-9);
+  test.Confirm(Range(1.0, 8.5).t_ns);
+  const UsblRateVerdict multipath = test.Check(Range(2.0, 8.0 + 2.4));
+  EXPECT_FALSE(multipath.pass);
+  EXPECT_NE(multipath.reason.find("last good range"), std::string::npos) << multipath.reason;
+  EXPECT_TRUE(test.Check(Range(3.0, 7.5)).pass);  // 1.0 m in 2 s from the reference
+}
+
 }  // namespace
 }  // namespace auvdock

@@ -6,9 +6,9 @@
 // factors/time_shifted_factor.h), so every sample is used at its own time whatever the
 // sensor's rate and clock, without a state of its own. A residual beyond its chi-square gate
 // after a solve is removed, and counted; the sliding window also gives each a Huber loss
-// (huber_sigmas on the whitened norm, as its lights), so that one absurd sample (a depth of
-// 1e9 m) cannot drag the window so far before its gate that every light is gated with it. The
-// batch smoother, which gates with every measurement in, uses none (+infinity).
+// (EstimatorOptions::sensor_huber_sigmas, wider than its lights'), so that one absurd sample (a
+// depth of 1e9 m) cannot drag the window so far before its gate that every light is gated with
+// it. The batch smoother, which gates with every measurement in, uses none (+infinity).
 //   depth  factors/depth_factor.h  1 residual, on the pose (and the velocity when shifted)
 //   DVL    factors/dvl_factor.h    3 residuals, on the pose and the velocity; the body rate from
 //                                  the gyro held at t minus the state's gyro bias

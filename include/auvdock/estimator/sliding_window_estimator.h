@@ -164,6 +164,15 @@ struct EstimatorOptions {
   // each range on its own, 1 dof, p = 0.999, with its own sigma.
   bool use_sbl = true;
   double sbl_gate_chi2 = 10.83;
+  // The Huber threshold (whitened norm) of the depth, DVL, USBL and SBL residuals: their gates
+  // act after the solve, and without a bounded influence one absurd sample (a depth of 1e9 m)
+  // drags the whole window in that solve, every light out of its gate with it. Wider than the
+  // lights' (2.5): a window that started wrong is pulled back by these sensors, and a tight
+  // loss slows that down (README, "The fault matrix"). 1e9: in effect no loss.
+  double sensor_huber_sigmas = 10.0;
+  // The rate-of-change test per transducer (usbl_rate_test.h, with usbl_rate_test's speed and
+  // gate): a multipath reply that lengthens a range faster than the vehicle moves.
+  bool sbl_rate_test = true;
   // Multiplies the calibration's IMU noise densities and random walks (sigma, not variance).
   // Datasheet values are measured on a bench, at constant temperature, without vibration; on a
   // vehicle the effective noise is larger (a real EuRoC sequence gives a chi-square about 100x
@@ -222,6 +231,7 @@ struct EstimatorStats {
   int sbl_used = 0;       // SBL ranges in the cost (after gating)
   int sbl_gated = 0;      // beyond the SBL gate
   int sbl_skipped = 0;    // not finite, unknown transducer, out of order, no state or IMU
+  int sbl_rate_rejected = 0;  // failed the rate-of-change test
   // The adaptive variance factors in use at the end, per light id.
   std::map<int, double> mono_variance_factor;
   std::map<int, double> stereo_variance_factor;
@@ -336,6 +346,8 @@ class SlidingWindowEstimator {
   AdaptiveNoiseScale depth_noise_;  // the depth's (adaptive_depth_noise)
   DepthSecondDifference depth_innovation_;
   UsblRateTest usbl_rate_test_;
+  std::vector<UsblRateTest> sbl_rate_tests_;  // one per transducer
+  std::map<ceres::ResidualBlockId, int> sbl_transducer_of_;  // the newest frame's SBL residuals
   HeldDvlReadingCheck held_dvl_reading_;
   int64_t last_depth_sample_t_ns_ = INT64_MIN;  // of the newest sample taken
   int64_t last_dvl_sample_t_ns_ = INT64_MIN;
