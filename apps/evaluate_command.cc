@@ -55,6 +55,8 @@ void AddNeesJson(const ErrorStats& stats, nlohmann::ordered_json* j) {
   (*j)["nees_n"] = stats.nees_n;
   (*j)["nees_mean"] = stats.nees_mean;
   (*j)["nees_above_95"] = stats.nees_above_95;
+  (*j)["nees_correlation_poses"] = stats.nees_correlation_poses;
+  (*j)["nees_effective_n"] = stats.nees_effective_n;
 }
 
 // NaN (no bound in a group) is written as null by nlohmann::json.

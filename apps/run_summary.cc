@@ -80,7 +80,8 @@ void PrintSkippedRows(const char* command, const std::vector<std::string>& skipp
     std::fprintf(stderr, "auvdock: %s: %s\n", command, skipped_rows[i].c_str());
   }
   if (skipped_rows.size() > max_lines) {
-    std::fprintf(stderr, "auvdock: %s: ... and %zu more rows skipped (summary.json \"log\" lists them)\n",
+    std::fprintf(stderr,
+                 "auvdock: %s: ... and %zu more rows skipped (summary.json \"log\" lists them)\n",
                  command, skipped_rows.size() - max_lines);
   }
 }

@@ -75,6 +75,7 @@ def rows(path):
 
 for command in commands:
     nees, in_band, below, above = [], 0, 0, 0
+    eff_in_band, eff_below, eff_above, taus = 0, 0, 0, []
     unsafe, worst_lat, resets, failures, missing = 0, 0.0, 0, 0, 0
     go_lit, lit, rmse = 0, 0, []
     for seed in seeds:
@@ -92,6 +93,15 @@ for command in commands:
             in_band += lo <= m <= hi
             below += m < lo
             above += m > hi
+            # The same band for the number of independent values the mean is worth (successive
+            # poses' NEES are correlated: evaluate's nees_effective_n).
+            n_eff = r.get("nees_effective_n")
+            if n_eff:
+                taus.append(r["nees_correlation_poses"])
+                lo, hi = chi2_mean_band(n_eff)
+                eff_in_band += lo <= m <= hi
+                eff_below += m < lo
+                eff_above += m > hi
         a = r["decisions"]
         unsafe += a["n_go_unsafe"]
         worst_lat = max(worst_lat, a["max_lateral_error_at_go_m"] or 0.0)
@@ -114,6 +124,12 @@ for command in commands:
           f"max {nees[-1] if nees else float('nan'):.2f}")
     print(f"  runs with mean NEES in the 95 % band: {in_band} of {len(nees)} "
           f"({100.0 * in_band / max(len(nees), 1):.0f} %; {below} below, {above} above)")
+    taus.sort()
+    if taus:
+        print(f"  ... with the band of each run's effective number of independent values "
+              f"(NEES correlation time median {taus[len(taus) // 2]:.1f} poses): {eff_in_band} of "
+              f"{len(taus)} ({100.0 * eff_in_band / len(taus):.0f} %; {eff_below} below, "
+              f"{eff_above} above)")
     rmse.sort()
     print(f"  position RMSE per run: median {1e3 * rmse[len(rmse) // 2] if rmse else float('nan'):.1f} mm, "
           f"max {1e3 * rmse[-1] if rmse else float('nan'):.1f} mm")

@@ -8,6 +8,7 @@
 #include <limits>
 #include <string>
 #include <unordered_map>
+#include <vector>
 
 #include "auvdock/eval/trajectory_alignment.h"
 #include "auvdock/eval/truth_interpolation.h"
@@ -20,6 +21,9 @@ namespace {
 constexpr int kNumStages = static_cast<int>(VisibilityStage::kUnknown) + 1;
 // RPE pairs whose time step misses delta by more than this fraction of delta are not used.
 constexpr double kRpeTimeTolerance = 0.1;
+// IntegratedAutocorrelationTime sums lags up to this (a slowly trending series would otherwise
+// cost n^2 on a long log).
+constexpr int kMaxAutocorrelationLag = 1000;
 
 struct MatchedPose {
   int64_t t_ns = 0;
@@ -61,6 +65,7 @@ class ErrorAccumulator {
     ++nees_n_;
     nees_sum_ += nees;
     if (nees > kNees95) ++nees_above_;
+    nees_series_.push_back(nees);
   }
 
   // The bound at a pose, with that pose's own errors.
@@ -88,6 +93,8 @@ class ErrorAccumulator {
     stats.nees_mean = nees_n_ > 0 ? nees_sum_ / nees_n_ : std::nan("");
     stats.nees_above_95 =
         nees_n_ > 0 ? static_cast<double>(nees_above_) / nees_n_ : std::nan("");
+    stats.nees_correlation_poses = IntegratedAutocorrelationTime(nees_series_);
+    stats.nees_effective_n = nees_n_ / stats.nees_correlation_poses;
     stats.bound_n = bound_n_;
     const auto rms = [&](double sum) {
       return bound_n_ > 0 ? std::sqrt(sum / bound_n_) : std::nan("");
@@ -109,6 +116,7 @@ class ErrorAccumulator {
   int nees_n_ = 0;
   int nees_above_ = 0;
   double nees_sum_ = 0.0;
+  std::vector<double> nees_series_;  // in time order
   int bound_n_ = 0;
   double bound_pos_sum_ = 0.0, bound_att_sum_ = 0.0;
   double at_bound_pos_sq_ = 0.0, at_bound_att_sq_ = 0.0;
@@ -232,6 +240,26 @@ DecisionAudit AuditDecisions(const std::vector<MatchedPose>& matched,
 }
 
 }  // namespace
+
+double IntegratedAutocorrelationTime(const std::vector<double>& series) {
+  const int n = static_cast<int>(series.size());
+  if (n < 2) return std::nan("");
+  double mean = 0.0;
+  for (double x : series) mean += x;
+  mean /= n;
+  double variance = 0.0;
+  for (double x : series) variance += (x - mean) * (x - mean);
+  if (!(variance > 0.0)) return std::nan("");
+  double tau = 1.0;
+  for (int lag = 1; lag < std::min(n, kMaxAutocorrelationLag + 1); ++lag) {
+    double covariance = 0.0;
+    for (int i = 0; i + lag < n; ++i) covariance += (series[i] - mean) * (series[i + lag] - mean);
+    const double rho = covariance / variance;
+    if (!(rho > 0.0)) break;
+    tau += 2.0 * rho;
+  }
+  return tau;
+}
 
 const char* AlignmentName(Alignment alignment) {
   switch (alignment) {

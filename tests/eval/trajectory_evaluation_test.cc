@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -425,6 +426,23 @@ TEST(AlignmentNameTest, RoundTrips) {
   }
   Alignment unused;
   EXPECT_FALSE(ParseAlignment("sim3", &unused));
+}
+
+// White values are worth one each; values that each repeat 5 times are worth a fifth:
+// rho_k = (5 - k) / 5 for k < 5, so tau = 1 + 2 (0.8 + 0.6 + 0.4 + 0.2) = 5.
+TEST(IntegratedAutocorrelationTimeTest, WhiteValuesAndRepeatedValues) {
+  std::mt19937 rng(7);
+  std::chi_squared_distribution<double> chi2(6.0);
+  std::vector<double> white, repeated;
+  for (int i = 0; i < 4000; ++i) white.push_back(chi2(rng));
+  for (int i = 0; i < 4000; ++i) {
+    const double x = chi2(rng);
+    for (int r = 0; r < 5; ++r) repeated.push_back(x);
+  }
+  EXPECT_NEAR(IntegratedAutocorrelationTime(white), 1.0, 0.1);
+  EXPECT_NEAR(IntegratedAutocorrelationTime(repeated), 5.0, 0.3);
+  EXPECT_TRUE(std::isnan(IntegratedAutocorrelationTime({3.0})));
+  EXPECT_TRUE(std::isnan(IntegratedAutocorrelationTime({2.0, 2.0, 2.0})));
 }
 
 }  // namespace

@@ -92,6 +92,12 @@ struct ErrorStats {
   int nees_n = 0;               // poses with a covariance
   double nees_mean = 0.0;       // NaN when nees_n == 0
   double nees_above_95 = 0.0;   // fraction of NEES > kNees95; NaN when nees_n == 0
+  // The NEES of successive poses are not independent (an error lasts as long as what caused it):
+  // their integrated autocorrelation time in poses (IntegratedAutocorrelationTime) and
+  // nees_n / that, the number of independent values the mean is worth. A 95 % band for
+  // nees_mean must use nees_effective_n, not nees_n. NaN when nees_n < 2.
+  double nees_correlation_poses = 0.0;
+  double nees_effective_n = 0.0;
   // With a Cramér–Rao bound (EstimateReports::bounds): over the poses that have one,
   // sqrt(mean tr P_p) and sqrt(mean tr P_theta), the RMS errors that the best unbiased estimator
   // would have, and pos_rmse_m / att_rmse_rad over the same poses. NaN when bound_n == 0.
@@ -101,6 +107,13 @@ struct ErrorStats {
   double pos_rmse_at_bound_m = 0.0;
   double att_rmse_at_bound_rad = 0.0;
 };
+
+// tau = 1 + 2 sum_{k>=1} rho_k of a series, the sum stopped at the first lag whose sample
+// autocorrelation rho_k is not positive (the initial positive sequence): how many successive
+// values carry the information of one independent value (1 for white values, about 5 for
+// values that each repeat 5 times); lags up to 1000. NaN for fewer than 2 values or a constant
+// series.
+double IntegratedAutocorrelationTime(const std::vector<double>& series);
 
 // The 95 % point of the chi-square distribution with 6 degrees of freedom.
 inline constexpr double kNees95 = 12.5916;
