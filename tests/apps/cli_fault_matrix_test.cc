@@ -14,6 +14,7 @@
 #include <fstream>
 #include <functional>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -151,6 +152,13 @@ const std::vector<StreamFault>& StreamFaults() {
   return faults;
 }
 
+const StreamFault& FaultNamed(const std::string& name) {
+  for (const StreamFault& fault : StreamFaults()) {
+    if (fault.name == name) return fault;
+  }
+  throw std::invalid_argument("no stream fault named " + name);
+}
+
 struct RunOutcome {
   test::CommandResult result;
   std::string out;
@@ -272,8 +280,7 @@ TEST_F(FaultMatrix, AnImuClockThatJumpsBackEndsTheImuStream) {
   const std::string ds = Copy("imu_clock");
   const std::string file = ds + "/imu0/data.csv";
   const std::vector<std::string> lines = Lines(test::ReadTextFile(file));
-  const Rows rows =
-      StreamFaults()[2].rows(Rows(lines.begin() + 1, lines.end()));  // runs_backwards
+  const Rows rows = FaultNamed("runs_backwards").rows(Rows(lines.begin() + 1, lines.end()));
   test::WriteTextFile(file, Join(lines[0], rows));
   const RunOutcome run = RunOn("run", ds, ds + "/out");
   ExpectWentOn(run, dataset_, "IMU clock jump");
