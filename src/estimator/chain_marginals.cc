@@ -1,21 +1,32 @@
 #include "auvdock/estimator/chain_marginals.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/SparseCore>
+#include <Eigen/Cholesky>
 #include <ceres/crs_matrix.h>
 
 namespace auvdock {
+namespace {
 
-std::optional<std::vector<std::optional<Eigen::MatrixXd>>> ChainMarginals(
-    ceres::Problem* problem, const std::vector<std::vector<double*>>& states,
-    const ChainMarginalsOptions& options) {
+// The Jacobi-scaled information of a chain, W H W with W = diag(H)^-1/2, in blocks: D[k] state k
+// with itself, B[k] state k with state k + 1 (joined[k]: some factor links them).
+struct ScaledChain {
+  std::vector<int> start;  // each state's first tangent column; start[n] = all columns
+  Eigen::VectorXd w;       // the scaling's diagonal; 0 for a coordinate without information
+  std::vector<Eigen::MatrixXd> D, B;
+  std::vector<bool> joined;
+};
+
+// nullopt when the problem is not a chain of these states or cannot be evaluated.
+std::optional<ScaledChain> AssembleScaledChain(ceres::Problem* problem,
+                                               const std::vector<std::vector<double*>>& states) {
   const int n = static_cast<int>(states.size());
+  ScaledChain chain;
+  chain.start.assign(n + 1, 0);
   std::vector<double*> blocks;
-  std::vector<int> start(n + 1, 0);     // each state's first tangent column
   for (int k = 0; k < n; ++k) {
     int size = 0;
     for (double* block : states[k]) {
@@ -26,99 +37,170 @@ std::optional<std::vector<std::optional<Eigen::MatrixXd>>> ChainMarginals(
       blocks.push_back(block);
       size += problem->ParameterBlockTangentSize(block);
     }
-    start[k + 1] = start[k] + size;
+    chain.start[k + 1] = chain.start[k] + size;
   }
   if (static_cast<int>(blocks.size()) != problem->NumParameterBlocks()) return std::nullopt;
-  std::vector<std::optional<Eigen::MatrixXd>> marginals(n);
-  if (n == 0) return marginals;
+  const int columns = chain.start[n];
+  std::vector<int> state_of(columns);
+  for (int k = 0; k < n; ++k) {
+    for (int c = chain.start[k]; c < chain.start[k + 1]; ++c) state_of[c] = k;
+  }
+  chain.D.resize(n);
+  chain.B.resize(n > 0 ? n - 1 : 0);
+  chain.joined.assign(n > 0 ? n - 1 : 0, false);
+  for (int k = 0; k < n; ++k) {
+    const int size = chain.start[k + 1] - chain.start[k];
+    chain.D[k] = Eigen::MatrixXd::Zero(size, size);
+    if (k + 1 < n) chain.B[k] = Eigen::MatrixXd::Zero(size, chain.start[k + 2] - chain.start[k + 1]);
+  }
+  if (n == 0) return chain;
 
   ceres::Problem::EvaluateOptions evaluate;
   evaluate.parameter_blocks = blocks;
   evaluate.apply_loss_function = true;
   ceres::CRSMatrix crs;
   if (!problem->Evaluate(evaluate, nullptr, nullptr, nullptr, &crs)) return std::nullopt;
-  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor, int>> J(
-      crs.num_rows, crs.num_cols, static_cast<Eigen::Index>(crs.values.size()), crs.rows.data(),
-      crs.cols.data(), crs.values.data());
-  const Eigen::SparseMatrix<double> H = J.transpose() * J;
-
-  // The state of every column.
-  std::vector<int> state_of(start[n]);
-  for (int k = 0; k < n; ++k) {
-    for (int c = start[k]; c < start[k + 1]; ++c) state_of[c] = k;
-  }
-  // Jacobi scaling: the sweeps run on H~ = W H W, W = diag(H)^-1/2 (unit diagonal), so that the
-  // rank test compares like with like whatever the units (metres, rad/s of a bias).
-  Eigen::VectorXd w(start[n]);
-  for (int c = 0; c < start[n]; ++c) {
-    const double h = H.coeff(c, c);
-    w(c) = h > 0.0 ? 1.0 / std::sqrt(h) : 0.0;  // 0: unobserved, caught by the rank test
-  }
-  std::vector<Eigen::MatrixXd> D(n), B(n > 0 ? n - 1 : 0);
-  for (int k = 0; k < n; ++k) {
-    const int size = start[k + 1] - start[k];
-    D[k] = Eigen::MatrixXd::Zero(size, size);
-    if (k + 1 < n) B[k] = Eigen::MatrixXd::Zero(size, start[k + 2] - start[k + 1]);
-  }
-  std::vector<bool> joined(n > 0 ? n - 1 : 0, false);  // some factor links k and k + 1
-  for (int c = 0; c < H.outerSize(); ++c) {
-    const int kc = state_of[c];
-    for (Eigen::SparseMatrix<double>::InnerIterator it(H, c); it; ++it) {
-      const int r = static_cast<int>(it.row());
-      const int kr = state_of[r];
-      const double scaled = w(r) * it.value() * w(c);
-      if (kr == kc) {
-        D[kc](r - start[kc], c - start[kc]) = scaled;
-      } else if (kc == kr + 1) {
-        B[kr](r - start[kr], c - start[kc]) = scaled;
-        joined[kr] = true;
-      } else if (std::abs(kr - kc) > 1) {
-        return std::nullopt;  // not a chain
+  // H = J^T J accumulated straight into the blocks. Consecutive rows with the same columns (one
+  // residual block's rows) form a small dense J_g; J_g^T J_g is scattered into D and B (a group
+  // touches one state or two neighbours). D[k] gets both triangles; B[k] = H_{k,k+1} only.
+  Eigen::MatrixXd J_g, H_g;
+  int row = 0;
+  while (row < crs.num_rows) {
+    const int begin = crs.rows[row], width = crs.rows[row + 1] - begin;
+    int rows = 1;
+    while (row + rows < crs.num_rows &&
+           crs.rows[row + rows + 1] - crs.rows[row + rows] == width &&
+           std::equal(crs.cols.begin() + begin, crs.cols.begin() + begin + width,
+                      crs.cols.begin() + crs.rows[row + rows])) {
+      ++rows;
+    }
+    J_g.resize(rows, width);
+    for (int i = 0; i < rows; ++i) {
+      for (int j = 0; j < width; ++j) J_g(i, j) = crs.values[crs.rows[row + i] + j];
+    }
+    H_g.noalias() = J_g.transpose() * J_g;
+    for (int a = 0; a < width; ++a) {
+      const int ca = crs.cols[begin + a], ka = state_of[ca];
+      for (int b = 0; b < width; ++b) {
+        const int cb = crs.cols[begin + b], kb = state_of[cb];
+        if (ka == kb) {
+          chain.D[ka](ca - chain.start[ka], cb - chain.start[ka]) += H_g(a, b);
+        } else if (kb == ka + 1) {
+          chain.B[ka](ca - chain.start[ka], cb - chain.start[kb]) += H_g(a, b);
+          chain.joined[ka] = true;
+        } else if (std::abs(ka - kb) > 1) {
+          return std::nullopt;  // not a chain
+        }
       }
     }
+    row += rows;
   }
-
-  // Forward: S_k and its inverse; a rank-deficient S_k marks its segment.
-  std::vector<Eigen::MatrixXd> S_inv(n);
-  std::vector<int> segment(n, 0);
-  std::vector<bool> segment_ok(1, true);
+  // Jacobi scaling: the sweeps run on W H W (unit diagonal), so that the rank test compares like
+  // with like whatever the units (metres, rad/s of a bias).
+  chain.w.resize(columns);
   for (int k = 0; k < n; ++k) {
-    Eigen::MatrixXd S = D[k];
-    if (k > 0 && joined[k - 1]) {
-      segment[k] = segment[k - 1];
-      S -= B[k - 1].transpose() * S_inv[k - 1] * B[k - 1];
+    for (int i = 0; i < chain.D[k].rows(); ++i) {
+      const double h = chain.D[k](i, i);
+      chain.w(chain.start[k] + i) = h > 0.0 ? 1.0 / std::sqrt(h) : 0.0;  // 0: caught below
+    }
+  }
+  for (int k = 0; k < n; ++k) {
+    const int size = chain.start[k + 1] - chain.start[k];
+    const Eigen::VectorXd wk = chain.w.segment(chain.start[k], size);
+    chain.D[k] = wk.asDiagonal() * chain.D[k] * wk.asDiagonal();
+    if (k + 1 < n) {
+      const Eigen::VectorXd wn =
+          chain.w.segment(chain.start[k + 1], chain.start[k + 2] - chain.start[k + 1]);
+      chain.B[k] = wk.asDiagonal() * chain.B[k] * wn.asDiagonal();
+    }
+  }
+  return chain;
+}
+
+// The forward sweep: S_k^-1 for every state, each state's segment (states joined by factors)
+// and whether that segment is of full rank.
+struct ForwardSweep {
+  std::vector<Eigen::MatrixXd> S_inv;
+  std::vector<int> segment;
+  std::vector<bool> segment_ok;
+};
+
+ForwardSweep SweepForward(const ScaledChain& chain, const ChainMarginalsOptions& options) {
+  const int n = static_cast<int>(chain.D.size());
+  ForwardSweep sweep;
+  sweep.S_inv.resize(n);
+  sweep.segment.assign(n, 0);
+  sweep.segment_ok.assign(1, true);
+  for (int k = 0; k < n; ++k) {
+    Eigen::MatrixXd S = chain.D[k];
+    if (k > 0 && chain.joined[k - 1]) {
+      sweep.segment[k] = sweep.segment[k - 1];
+      S -= chain.B[k - 1].transpose() * sweep.S_inv[k - 1] * chain.B[k - 1];
     } else if (k > 0) {
-      segment[k] = segment[k - 1] + 1;
-      segment_ok.push_back(true);
+      sweep.segment[k] = sweep.segment[k - 1] + 1;
+      sweep.segment_ok.push_back(true);
     }
     S = 0.5 * (S + S.transpose()).eval();
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(S);
-    const Eigen::VectorXd& values = eig.eigenvalues();
-    if (eig.info() != Eigen::Success || !(values.minCoeff() > options.min_eigenvalue)) {
-      segment_ok[segment[k]] = false;
-      S_inv[k] = Eigen::MatrixXd::Zero(S.rows(), S.cols());  // keeps the sweep finite
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
+        !(ldlt.vectorD().minCoeff() > options.min_pivot)) {
+      sweep.segment_ok[sweep.segment[k]] = false;
+      sweep.S_inv[k] = Eigen::MatrixXd::Zero(S.rows(), S.cols());  // keeps the sweep finite
       continue;
     }
-    S_inv[k] = eig.eigenvectors() * values.cwiseInverse().asDiagonal() *
-               eig.eigenvectors().transpose();
+    sweep.S_inv[k] = ldlt.solve(Eigen::MatrixXd::Identity(S.rows(), S.cols()));
   }
+  return sweep;
+}
+
+// Back from the scaled coordinates: Sigma = W Sigma~ W; nullopt if not finite.
+std::optional<Eigen::MatrixXd> Unscaled(const ScaledChain& chain, int k,
+                                        const Eigen::MatrixXd& scaled) {
+  const Eigen::VectorXd wk = chain.w.segment(chain.start[k], chain.start[k + 1] - chain.start[k]);
+  const Eigen::MatrixXd sigma = wk.asDiagonal() * scaled * wk.asDiagonal();
+  if (!sigma.allFinite()) return std::nullopt;
+  return sigma;
+}
+
+}  // namespace
+
+std::optional<std::vector<std::optional<Eigen::MatrixXd>>> ChainMarginals(
+    ceres::Problem* problem, const std::vector<std::vector<double*>>& states,
+    const ChainMarginalsOptions& options) {
+  const std::optional<ScaledChain> chain = AssembleScaledChain(problem, states);
+  if (!chain) return std::nullopt;
+  const int n = static_cast<int>(states.size());
+  std::vector<std::optional<Eigen::MatrixXd>> marginals(n);
+  if (n == 0) return marginals;
+  const ForwardSweep sweep = SweepForward(*chain, options);
   // Backward: the marginals.
   Eigen::MatrixXd next;
   for (int k = n - 1; k >= 0; --k) {
-    Eigen::MatrixXd sigma = S_inv[k];
-    if (k + 1 < n && joined[k]) {
-      const Eigen::MatrixXd G = S_inv[k] * B[k];
+    Eigen::MatrixXd sigma = sweep.S_inv[k];
+    if (k + 1 < n && chain->joined[k]) {
+      const Eigen::MatrixXd G = sweep.S_inv[k] * chain->B[k];
       sigma += G * next * G.transpose();
     }
     sigma = 0.5 * (sigma + sigma.transpose()).eval();
     next = sigma;
-    if (!segment_ok[segment[k]]) continue;
-    // Back from the scaled coordinates: Sigma = W Sigma~ W.
-    const Eigen::VectorXd wk = w.segment(start[k], start[k + 1] - start[k]);
-    const Eigen::MatrixXd unscaled = wk.asDiagonal() * sigma * wk.asDiagonal();
-    if (unscaled.allFinite()) marginals[k] = unscaled;
+    if (sweep.segment_ok[sweep.segment[k]]) marginals[k] = Unscaled(*chain, k, sigma);
   }
   return marginals;
+}
+
+std::optional<LastStateMarginal> ChainMarginalOfLast(
+    ceres::Problem* problem, const std::vector<std::vector<double*>>& states,
+    const ChainMarginalsOptions& options) {
+  if (states.empty()) throw std::invalid_argument("ChainMarginalOfLast: no state");
+  const std::optional<ScaledChain> chain = AssembleScaledChain(problem, states);
+  if (!chain) return std::nullopt;
+  const ForwardSweep sweep = SweepForward(*chain, options);
+  const int last = static_cast<int>(states.size()) - 1;
+  LastStateMarginal result;
+  if (sweep.segment_ok[sweep.segment[last]]) {
+    result.covariance = Unscaled(*chain, last, sweep.S_inv[last]);
+  }
+  return result;
 }
 
 }  // namespace auvdock

@@ -7,12 +7,14 @@
 #include <stdexcept>
 #include <utility>
 
+#include <ceres/iteration_callback.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
 
-#include "auvdock/estimator/sensor_factors.h"
+#include "auvdock/estimator/chain_marginals.h"
 #include "auvdock/estimator/marginal_covariance.h"
 #include "auvdock/estimator/marginalization.h"
+#include "auvdock/estimator/sensor_factors.h"
 #include "factors/bias_prior_factor.h"
 #include "factors/imu_preintegration_factor.h"
 #include "factors/marginalization_factor.h"
@@ -26,6 +28,21 @@ namespace {
 constexpr double kNsPerSecond = 1e9;
 
 double Seconds(int64_t ns) { return static_cast<double>(ns) / kNsPerSecond; }
+
+// Ends a solve once a successful step lowered the cost by less than an absolute amount
+// (EstimatorOptions::solver_cost_tolerance); Ceres keeps that step's values.
+class AbsoluteCostChangeStop : public ceres::IterationCallback {
+ public:
+  explicit AbsoluteCostChangeStop(double tolerance) : tolerance_(tolerance) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& iteration) override {
+    const bool converged = iteration.iteration > 0 && iteration.step_is_successful &&
+                           iteration.cost_change < tolerance_;
+    return converged ? ceres::SOLVER_TERMINATE_SUCCESSFULLY : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  double tolerance_;
+};
 
 }  // namespace
 
@@ -225,6 +242,8 @@ bool SlidingWindowEstimator::Solve() {
   options.num_threads = 1;
   options.logging_type = ceres::SILENT;
   options.minimizer_progress_to_stdout = false;
+  AbsoluteCostChangeStop stop(options_.solver_cost_tolerance);
+  if (options_.solver_cost_tolerance > 0.0) options.callbacks.push_back(&stop);
   ceres::Solver::Summary summary;
   ceres::Solve(options, problem_.get(), &summary);
   if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) return false;
@@ -461,6 +480,24 @@ void SlidingWindowEstimator::MarginalizeOldest() {
   }
 }
 
+std::optional<Eigen::MatrixXd> SlidingWindowEstimator::PoseCovariance(const State& state,
+                                                                      std::string* reason) {
+  if (&state != window_.back().get()) {
+    return MarginalCovariance(problem_.get(), state.pose, {}, reason);
+  }
+  // The window is a chain (IMU factors between neighbours, every other factor on one state, the
+  // marginalisation prior on the oldest): the forward sweep gives the newest state's marginal.
+  std::vector<std::vector<double*>> states;
+  for (const auto& s : window_) states.push_back({s->pose, s->velocity, s->bias});
+  const std::optional<LastStateMarginal> last = ChainMarginalOfLast(problem_.get(), states);
+  if (!last) return MarginalCovariance(problem_.get(), state.pose, {}, reason);
+  if (!last->covariance) {
+    *reason = "rank-deficient information (an unobserved direction)";
+    return std::nullopt;
+  }
+  return last->covariance->topLeftCorner(kPoseTangentSize, kPoseTangentSize).eval();
+}
+
 EstimatorOutput SlidingWindowEstimator::Output(const State& state) {
   EstimatorOutput out;
   out.symmetry_unresolved = symmetry_unresolved_;
@@ -477,8 +514,7 @@ EstimatorOutput SlidingWindowEstimator::Output(const State& state) {
       last_dvl_t_ns_ == INT64_MIN ? -1.0 : std::max(0.0, Seconds(state.t_ns - last_dvl_t_ns_));
   if (options_.compute_covariance) {
     std::string reason;
-    const std::optional<Eigen::MatrixXd> covariance =
-        MarginalCovariance(problem_.get(), state.pose, {}, &reason);
+    const std::optional<Eigen::MatrixXd> covariance = PoseCovariance(state, &reason);
     if (covariance) {
       out.covariance = *covariance;
       out.covariance_ok = true;

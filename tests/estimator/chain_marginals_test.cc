@@ -1,11 +1,13 @@
 // ChainMarginals (estimator/chain_marginals.h) against ceres::Covariance on random linear chains:
 // the same marginals to rounding; a segment without information has none while the others keep
-// theirs; a factor across two states is not a chain; and a pose manifold block is handled in its
+// theirs; a factor across two states is not a chain; the last state's marginal alone
+// (ChainMarginalOfLast) is the same; and a pose manifold block is handled in its
 // tangent space (the batch smoother's case, checked end to end by the CRLB tests).
 #include "auvdock/estimator/chain_marginals.h"
 
 #include <memory>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include <ceres/ceres.h>
@@ -138,6 +140,32 @@ TEST(ChainMarginalsTest, ASegmentWithoutInformationHasNoCovarianceAndTheOthersKe
     const Eigen::MatrixXd expected = CeresMarginal(chain.get(), k);
     EXPECT_LT(((*marginals)[k].value() - expected).norm(), 1e-9 * expected.norm()) << k;
   }
+}
+
+TEST(ChainMarginalsTest, TheLastStateAloneEqualsCeresCovariance) {
+  for (uint32_t seed : {1u, 2u, 3u}) {
+    auto chain = MakeChain(12, seed);
+    const auto last = ChainMarginalOfLast(&chain->problem, chain->states);
+    ASSERT_TRUE(last);
+    ASSERT_TRUE(last->covariance);
+    const Eigen::MatrixXd expected = CeresMarginal(chain.get(), 11);
+    EXPECT_LT((*last->covariance - expected).norm(), 1e-9 * expected.norm()) << "seed " << seed;
+  }
+}
+
+TEST(ChainMarginalsTest, TheLastStateOfASingularSegmentHasNoCovariance) {
+  std::vector<int> unmeasured;
+  for (int k = 10; k < 20; ++k) unmeasured.push_back(k);
+  auto chain = MakeChain(20, 5, unmeasured, /*cut_after=*/9);
+  const auto last = ChainMarginalOfLast(&chain->problem, chain->states);
+  ASSERT_TRUE(last);
+  EXPECT_FALSE(last->covariance);
+  // Not a chain, no state: as ChainMarginals.
+  chain->problem.AddResidualBlock(new LinearBinary(Eigen::Matrix3d::Identity(),
+                                                   Eigen::Matrix3d::Identity()),
+                                  nullptr, chain->states[2][0], chain->states[5][0]);
+  EXPECT_FALSE(ChainMarginalOfLast(&chain->problem, chain->states));
+  EXPECT_THROW(ChainMarginalOfLast(&chain->problem, {}), std::invalid_argument);
 }
 
 TEST(ChainMarginalsTest, AFactorAcrossTwoStatesIsNotAChain) {

@@ -20,10 +20,17 @@
 // The sweeps run on the Jacobi-scaled information W H W, W = diag(H)^-1/2 (unit diagonal, so
 // that metres and a gyro bias's rad/s compare), and the marginals are scaled back, W Sigma W.
 //
+// The last state's marginal needs the forward sweep alone: Sigma_{n-1} = S_{n-1}^-1 (the
+// information form of a filter's update), O(n) with a small constant (the sliding window's
+// newest-pose covariance, every frame).
+//
+// H is accumulated straight into the blocks D_k and B_k, one residual block's rows at a time (they
+// touch one state or two neighbours), without forming J^T J as a general sparse product.
+//
 // Segments: B_k = 0 where no factor joins states k and k+1 (an IMU gap); the sweeps then treat
-// the two parts independently. Rank deficiency: a scaled S_k whose smallest eigenvalue is at or
-// below min_eigenvalue (a gauge freedom, an unobserved direction: rounding-level on the unit
-// diagonal), or a coordinate with no information at all, leaves its whole segment without
+// the two parts independently. Rank deficiency: a scaled S_k whose smallest pivot (of its
+// LDLT factorisation with diagonal pivoting) is at or below min_pivot (a gauge freedom, an
+// unobserved direction: rounding-level on the unit diagonal), or a coordinate with no information at all, leaves its whole segment without
 // covariances (nullopt for each of its states): a rank-deficient problem has no inverse to report.
 //
 // Units: those of the blocks' tangent spaces.
@@ -38,7 +45,7 @@
 namespace auvdock {
 
 struct ChainMarginalsOptions {
-  double min_eigenvalue = 1e-12;  // of a Jacobi-scaled S_k (see above)
+  double min_pivot = 1e-12;  // of a Jacobi-scaled S_k's LDLT (see above)
 };
 
 // states: each state's parameter blocks (all in the problem, none constant), in chain order.
@@ -48,6 +55,17 @@ struct ChainMarginalsOptions {
 // variable block belongs to no state) or cannot be evaluated: the caller falls back to a general
 // method. Throws std::invalid_argument for a block not in the problem.
 std::optional<std::vector<std::optional<Eigen::MatrixXd>>> ChainMarginals(
+    ceres::Problem* problem, const std::vector<std::vector<double*>>& states,
+    const ChainMarginalsOptions& options = {});
+
+// The last state's marginal covariance only (the forward sweep; see above): equal to
+// ChainMarginals(...)->back() to rounding. covariance is nullopt when the last state's segment
+// is rank-deficient; the whole result nullopt when the problem is not a chain (as above). Throws
+// std::invalid_argument for no state or a block not in the problem.
+struct LastStateMarginal {
+  std::optional<Eigen::MatrixXd> covariance;
+};
+std::optional<LastStateMarginal> ChainMarginalOfLast(
     ceres::Problem* problem, const std::vector<std::vector<double*>>& states,
     const ChainMarginalsOptions& options = {});
 

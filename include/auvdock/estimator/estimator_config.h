@@ -6,6 +6,7 @@
 //     window_size: 10
 //     max_solver_iterations: 10
 //     max_solver_time_s: 0.0          # 0 = no limit
+//     solver_cost_tolerance: 0.01     # a solve stops when a step lowers the cost by less
 //     huber_sigmas: 2.5
 //     mono_gate_chi2: 13.82
 //     stereo_gate_chi2: 16.27
