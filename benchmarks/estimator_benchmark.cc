@@ -26,9 +26,9 @@ const test::SyntheticRun& DefaultRun() {
   return run;
 }
 
-void RunWindow(benchmark::State& state, bool covariance, int window) {
+void RunWindow(benchmark::State& state, bool covariance, int window,
+               EstimatorOptions options = EstimatorOptions()) {
   const test::SyntheticRun& run = DefaultRun();
-  EstimatorOptions options;
   options.compute_covariance = covariance;
   options.window_size = window;
   std::vector<double> update_ms;
@@ -79,6 +79,24 @@ void BM_WindowSize(benchmark::State& state) {
   RunWindow(state, true, static_cast<int>(state.range(0)));
 }
 BENCHMARK(BM_WindowSize)->Arg(5)->Arg(10)->Arg(20)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// The solver's work per frame side by side: Ceres' own tolerances alone (cost tolerance 0, up to
+// 10 iterations), the default absolute cost tolerance, and 1-3 iterations at most.
+void BM_WindowSolverWork(benchmark::State& state) {
+  EstimatorOptions options;
+  options.solver_cost_tolerance = state.range(0) == 0 ? 0.0 : EstimatorOptions().solver_cost_tolerance;
+  if (state.range(1) > 0) options.max_solver_iterations = static_cast<int>(state.range(1));
+  RunWindow(state, true, 10, options);
+}
+BENCHMARK(BM_WindowSolverWork)
+    ->ArgNames({"cost_tol", "max_iter"})
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({1, 3})
+    ->Args({1, 2})
+    ->Args({1, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
 
 }  // namespace
 }  // namespace auvdock

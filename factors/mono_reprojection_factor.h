@@ -33,8 +33,8 @@
 #pragma once
 
 #include <array>
-#include <memory>
 #include <cmath>
+#include <memory>
 #include <limits>
 #include <stdexcept>
 
@@ -45,6 +45,7 @@
 
 #include "auvdock/camera/pinhole_radtan_camera.h"
 #include "auvdock/geometry/pose3.h"
+#include "factors/analytic_pose_cost_function.h"
 #include "factors/pose_manifold.h"
 
 namespace auvdock {
@@ -115,6 +116,40 @@ class MonoReprojectionFactor {
     return true;
   }
 
+  // The residual and its analytic Jacobian in the pose's tangent space (dp, dtheta; J may be
+  // null), for AnalyticPoseCostFunction. With A = R_C_B R_D_B^T and v = p_D_L - p_D_B:
+  //   dp_C/ddp = -A,   dp_C/ddtheta = A [v]x      (left perturbation R_D_B <- Exp(dtheta) R_D_B)
+  //   d(x, y)/dp_C = [1/Z 0 -X/Z^2; 0 1/Z -Y/Z^2]
+  //   d(x_d, y_d)/d(x, y): the radtan polynomial's derivative (DistortionJacobian)
+  //   J = sqrt(w) sqrt_info diag(fx, fy) d(x_d, y_d)/d(x, y) d(x, y)/dp_C [-A, A [v]x]
+  bool EvaluateTangent(const double* pose_D_B, double* residuals,
+                       Eigen::Matrix<double, 2, kPoseTangentSize, Eigen::RowMajor>* J) const {
+    const Eigen::Map<const Eigen::Vector3d> p_D_B(pose_D_B);
+    const Eigen::Map<const Eigen::Quaterniond> q_D_B(pose_D_B + 3);
+    const Eigen::Matrix3d A = q_C_B_.toRotationMatrix() * q_D_B.toRotationMatrix().transpose();
+    const Eigen::Vector3d v = p_D_L_ - p_D_B;
+    const Eigen::Vector3d p_C = A * v + p_C_B_;
+    if (!(p_C.z() > kMinDepth)) return false;
+    const double inv_z = 1.0 / p_C.z();
+    const double x = p_C.x() * inv_z, y = p_C.y() * inv_z;
+    double x_d, y_d;
+    DistortNormalized(distortion_, x, y, &x_d, &y_d);
+    const Eigen::Vector2d e(fx_ * x_d + cx_ - uv_(0), fy_ * y_d + cy_ - uv_(1));
+    Eigen::Map<Eigen::Vector2d> r(residuals);
+    r = weighted_sqrt_info_ * e;
+    if (J == nullptr) return true;
+    Eigen::Matrix<double, 2, 3> d_xy_d_pC;
+    d_xy_d_pC << inv_z, 0.0, -x * inv_z, 0.0, inv_z, -y * inv_z;
+    const Eigen::Matrix2d d_e_d_xy =
+        Eigen::Vector2d(fx_, fy_).asDiagonal() * DistortionJacobian(x, y);
+    const Eigen::Matrix<double, 2, 3> d_r_d_pC = weighted_sqrt_info_ * d_e_d_xy * d_xy_d_pC;
+    Eigen::Matrix3d v_cross;
+    v_cross << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+    J->leftCols<3>() = -d_r_d_pC * A;
+    J->rightCols<3>() = d_r_d_pC * A * v_cross;
+    return true;
+  }
+
   // The unweighted error pi(p_C) - uv (pixels); false (error untouched) when the light is behind
   // the camera.
   bool UnweightedError(const double* pose_D_B, Eigen::Vector2d* error) const {
@@ -143,7 +178,13 @@ class MonoReprojectionFactor {
                                                            information_weight));
   }
   // The same for a factor already built (e.g. after checking DepthInCamera).
+  // Create gives the analytic Jacobian (EvaluateTangent); CreateAutoDiff differentiates the
+  // templated operator() with ceres::Jet (the tests' reference).
   static ceres::CostFunction* Create(std::unique_ptr<MonoReprojectionFactor> factor) {
+    return new AnalyticPoseCostFunction<MonoReprojectionFactor, kMonoResidualSize>(
+        std::move(factor));
+  }
+  static ceres::CostFunction* CreateAutoDiff(std::unique_ptr<MonoReprojectionFactor> factor) {
     return new ceres::AutoDiffCostFunction<MonoReprojectionFactor, kMonoResidualSize, kPoseSize>(
         factor.release());
   }
@@ -164,6 +205,22 @@ class MonoReprojectionFactor {
     const Eigen::Map<const Eigen::Quaternion<T>> q_D_B(pose_D_B + 3);
     const Vector3T p_B = q_D_B.conjugate() * Vector3T(p_D_L_.cast<T>() - p_D_B);
     return q_C_B_.cast<T>() * p_B + p_C_B_.cast<T>();
+  }
+
+  // d(x_d, y_d)/d(x, y) of DistortNormalized, with R' = k1 + 2 k2 r2 + 3 k3 r2^2:
+  //   dx_d/dx = radial + 2 x^2 R' + 2 p1 y + 6 p2 x,   dx_d/dy = 2 x y R' + 2 p1 x + 2 p2 y
+  //   dy_d/dx = 2 x y R' + 2 p1 x + 2 p2 y,             dy_d/dy = radial + 2 y^2 R' + 6 p1 y + 2 p2 x
+  Eigen::Matrix2d DistortionJacobian(double x, double y) const {
+    const double k1 = distortion_[0], k2 = distortion_[1], p1 = distortion_[2],
+                 p2 = distortion_[3], k3 = distortion_[4];
+    const double r2 = x * x + y * y;
+    const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+    const double slope = k1 + r2 * (2.0 * k2 + 3.0 * k3 * r2);
+    const double cross = 2.0 * x * y * slope + 2.0 * p1 * x + 2.0 * p2 * y;
+    Eigen::Matrix2d D;
+    D << radial + 2.0 * x * x * slope + 2.0 * p1 * y + 6.0 * p2 * x, cross,
+        cross, radial + 2.0 * y * y * slope + 6.0 * p1 * y + 2.0 * p2 * x;
+    return D;
   }
 
   template <typename T>

@@ -29,6 +29,7 @@
 #pragma once
 
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include <ceres/autodiff_cost_function.h>
@@ -37,6 +38,7 @@
 #include <Eigen/Geometry>
 
 #include "auvdock/geometry/pose3.h"
+#include "factors/analytic_pose_cost_function.h"
 #include "factors/pose_manifold.h"
 
 namespace auvdock {
@@ -85,6 +87,28 @@ class StereoPointFactor {
     return true;
   }
 
+  // The residual and its analytic Jacobian in the pose's tangent space (dp, dtheta; J may be
+  // null), for AnalyticPoseCostFunction. With A = R_S_B R_D_B^T and v = p_D_L - p_D_B,
+  // p_S_pred = A v - R_S_B p_B_S and
+  //   J = sqrt(w) sqrt_info [-A, A [v]x]   (left perturbation R_D_B <- Exp(dtheta) R_D_B).
+  bool EvaluateTangent(const double* pose_D_B, double* residuals,
+                       Eigen::Matrix<double, 3, kPoseTangentSize, Eigen::RowMajor>* J) const {
+    const Eigen::Map<const Eigen::Vector3d> p_D_B(pose_D_B);
+    const Eigen::Map<const Eigen::Quaterniond> q_D_B(pose_D_B + 3);
+    const Eigen::Matrix3d R_S_B = T_B_S_.q.conjugate().toRotationMatrix();
+    const Eigen::Matrix3d A = R_S_B * q_D_B.toRotationMatrix().transpose();
+    const Eigen::Vector3d v = p_D_L_ - p_D_B;
+    Eigen::Map<Eigen::Vector3d> r(residuals);
+    r = weighted_sqrt_info_ * (A * v - R_S_B * T_B_S_.p - p_S_);
+    if (J == nullptr) return true;
+    Eigen::Matrix3d v_cross;
+    v_cross << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+    const Eigen::Matrix3d WA = weighted_sqrt_info_ * A;
+    J->leftCols<3>() = -WA;
+    J->rightCols<3>() = WA * v_cross;
+    return true;
+  }
+
   // The unweighted error p_S_pred - p_S (m, in S).
   Eigen::Vector3d UnweightedError(const double* pose_D_B) const { return Error(pose_D_B); }
 
@@ -102,8 +126,18 @@ class StereoPointFactor {
                                      const Eigen::Matrix3d& covariance_S, const Pose3& T_B_S,
                                      const Eigen::Vector3d& p_D_L,
                                      double information_weight = 1.0) {
+    return Create(
+        std::make_unique<StereoPointFactor>(p_S, covariance_S, T_B_S, p_D_L, information_weight));
+  }
+  // Create gives the analytic Jacobian (EvaluateTangent); CreateAutoDiff differentiates the
+  // templated operator() with ceres::Jet (the tests' reference).
+  static ceres::CostFunction* Create(std::unique_ptr<StereoPointFactor> factor) {
+    return new AnalyticPoseCostFunction<StereoPointFactor, kStereoPointResidualSize>(
+        std::move(factor));
+  }
+  static ceres::CostFunction* CreateAutoDiff(std::unique_ptr<StereoPointFactor> factor) {
     return new ceres::AutoDiffCostFunction<StereoPointFactor, kStereoPointResidualSize, kPoseSize>(
-        new StereoPointFactor(p_S, covariance_S, T_B_S, p_D_L, information_weight));
+        factor.release());
   }
 
   const Eigen::Vector3d& p_S() const { return p_S_; }

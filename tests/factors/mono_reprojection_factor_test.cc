@@ -133,6 +133,49 @@ TEST(MonoReprojectionFactorTest, JacobiansPassTheGradientCheckerWithThePoseManif
   }
 }
 
+// The analytic Jacobian (Create) against ceres::Jet's (CreateAutoDiff) in the tangent space
+// (ambient Jacobian times the manifold's PlusJacobian), with a strongly distorted camera and a
+// full covariance; and the residuals equal.
+TEST(MonoReprojectionFactorTest, AnalyticJacobianEqualsAutomaticDifferentiation) {
+  const PinholeRadtanCamera camera = DistortedCamera();
+  const Pose3 T_B_C = DownLookingExtrinsic();
+  const PoseManifold manifold;
+  Eigen::Matrix2d covariance;
+  covariance << 0.16, 0.03, 0.03, 0.25;
+  for (const Pose3& T_D_B : TestPoses()) {
+    for (const Eigen::Vector3d& in_camera :
+         {Eigen::Vector3d(0.7, -0.5, 1.8), Eigen::Vector3d(-1.2, 0.9, 2.0),
+          Eigen::Vector3d(0.0, 0.0, 4.0)}) {
+      const Eigen::Vector3d p_D_L = LightAt(T_D_B, T_B_C, in_camera);
+      const Eigen::Vector2d uv =
+          ReferencePixel(camera, T_D_B, T_B_C, p_D_L) + Eigen::Vector2d(2.0, -2.2);
+      std::unique_ptr<ceres::CostFunction> analytic(MonoReprojectionFactor::Create(
+          std::make_unique<MonoReprojectionFactor>(uv, covariance, camera, T_B_C, p_D_L, 0.7)));
+      std::unique_ptr<ceres::CostFunction> automatic(MonoReprojectionFactor::CreateAutoDiff(
+          std::make_unique<MonoReprojectionFactor>(uv, covariance, camera, T_B_C, p_D_L, 0.7)));
+      const Vector7 x = ToBlock(T_D_B);
+      const double* params[1] = {x.data()};
+      Eigen::Vector2d r_analytic, r_automatic;
+      Eigen::Matrix<double, 2, 7, Eigen::RowMajor> J_analytic, J_automatic;
+      double* jacobians_analytic[1] = {J_analytic.data()};
+      double* jacobians_automatic[1] = {J_automatic.data()};
+      ASSERT_TRUE(analytic->Evaluate(params, r_analytic.data(), jacobians_analytic));
+      ASSERT_TRUE(automatic->Evaluate(params, r_automatic.data(), jacobians_automatic));
+      EXPECT_LT((r_analytic - r_automatic).norm(), 1e-9 * (1.0 + r_automatic.norm()));
+      Eigen::Matrix<double, 7, 6, Eigen::RowMajor> plus;
+      ASSERT_TRUE(manifold.PlusJacobian(x.data(), plus.data()));
+      const Eigen::Matrix<double, 2, 6> tangent_analytic = J_analytic * plus;
+      const Eigen::Matrix<double, 2, 6> tangent_automatic = J_automatic * plus;
+      EXPECT_LT((tangent_analytic - tangent_automatic).norm(), 1e-9 * tangent_automatic.norm())
+          << "analytic\n" << tangent_analytic << "\nautomatic\n" << tangent_automatic;
+      // Residuals only (no Jacobian requested): the same residual.
+      Eigen::Vector2d r_only;
+      ASSERT_TRUE(analytic->Evaluate(params, r_only.data(), nullptr));
+      EXPECT_EQ(r_only, r_analytic);
+    }
+  }
+}
+
 // Undistorted pinhole, down-looking camera at the body origin, level body 2 m above a light
 // right below it. Moving the body by dx along the dock's x axis moves the light by -dx in B, i.e.
 // +dx along the image's y axis (image y = -body x): the pixel moves by fy dx / Z in v.

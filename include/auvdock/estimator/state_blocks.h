@@ -20,6 +20,7 @@
 
 #include "auvdock/estimator/imu_buffer.h"
 #include "auvdock/imu/imu_preintegration.h"
+#include "factors/analytic_pose_cost_function.h"
 #include "factors/time_shifted_factor.h"
 
 namespace auvdock {
@@ -46,16 +47,22 @@ std::optional<ImuPoseShift> ImuShiftFromState(const StateBlocks& state, int64_t 
 
 // Adds `factor` (an automatic-differentiation functor on the pose block with kResiduals
 // residuals, e.g. factors/depth_factor.h) on the state: directly on its pose when the shift is
-// the identity (dt 0), else through the shift on its pose and velocity (TimeShiftedFactor).
+// the identity (dt 0), with the factor's analytic Jacobian when it has one (EvaluateTangent,
+// factors/analytic_pose_cost_function.h: the vision factors), else through the shift on its pose
+// and velocity (TimeShiftedFactor, automatic differentiation).
 // loss may be null. The one way every measurement factor joins a state.
 template <typename Factor, int kResiduals>
 ceres::ResidualBlockId AddOnState(ceres::Problem* problem, std::unique_ptr<Factor> factor,
                                   const ImuPoseShift& shift, ceres::LossFunction* loss,
                                   const StateBlocks& state) {
   if (shift.dt_s == 0.0) {
-    return problem->AddResidualBlock(
-        new ceres::AutoDiffCostFunction<Factor, kResiduals, kPoseSize>(factor.release()), loss,
-        state.pose);
+    ceres::CostFunction* cost = nullptr;
+    if constexpr (HasTangentJacobian<Factor>::value) {
+      cost = new AnalyticPoseCostFunction<Factor, kResiduals>(std::move(factor));
+    } else {
+      cost = new ceres::AutoDiffCostFunction<Factor, kResiduals, kPoseSize>(factor.release());
+    }
+    return problem->AddResidualBlock(cost, loss, state.pose);
   }
   return problem->AddResidualBlock(
       TimeShiftedFactor<Factor, kResiduals>::Create(std::move(factor), shift), loss, state.pose,
