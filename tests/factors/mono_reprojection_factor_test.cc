@@ -13,6 +13,7 @@
 #include "auvdock/camera/pinhole_radtan_camera.h"
 #include "auvdock/geometry/pose3.h"
 #include "factors/pose_manifold.h"
+#include "tests/testing/tangent_jacobian_check.h"
 
 namespace auvdock {
 namespace {
@@ -139,7 +140,6 @@ TEST(MonoReprojectionFactorTest, JacobiansPassTheGradientCheckerWithThePoseManif
 TEST(MonoReprojectionFactorTest, AnalyticJacobianEqualsAutomaticDifferentiation) {
   const PinholeRadtanCamera camera = DistortedCamera();
   const Pose3 T_B_C = DownLookingExtrinsic();
-  const PoseManifold manifold;
   Eigen::Matrix2d covariance;
   covariance << 0.16, 0.03, 0.03, 0.25;
   for (const Pose3& T_D_B : TestPoses()) {
@@ -154,24 +154,7 @@ TEST(MonoReprojectionFactorTest, AnalyticJacobianEqualsAutomaticDifferentiation)
       std::unique_ptr<ceres::CostFunction> automatic(MonoReprojectionFactor::CreateAutoDiff(
           std::make_unique<MonoReprojectionFactor>(uv, covariance, camera, T_B_C, p_D_L, 0.7)));
       const Vector7 x = ToBlock(T_D_B);
-      const double* params[1] = {x.data()};
-      Eigen::Vector2d r_analytic, r_automatic;
-      Eigen::Matrix<double, 2, 7, Eigen::RowMajor> J_analytic, J_automatic;
-      double* jacobians_analytic[1] = {J_analytic.data()};
-      double* jacobians_automatic[1] = {J_automatic.data()};
-      ASSERT_TRUE(analytic->Evaluate(params, r_analytic.data(), jacobians_analytic));
-      ASSERT_TRUE(automatic->Evaluate(params, r_automatic.data(), jacobians_automatic));
-      EXPECT_LT((r_analytic - r_automatic).norm(), 1e-9 * (1.0 + r_automatic.norm()));
-      Eigen::Matrix<double, 7, 6, Eigen::RowMajor> plus;
-      ASSERT_TRUE(manifold.PlusJacobian(x.data(), plus.data()));
-      const Eigen::Matrix<double, 2, 6> tangent_analytic = J_analytic * plus;
-      const Eigen::Matrix<double, 2, 6> tangent_automatic = J_automatic * plus;
-      EXPECT_LT((tangent_analytic - tangent_automatic).norm(), 1e-9 * tangent_automatic.norm())
-          << "analytic\n" << tangent_analytic << "\nautomatic\n" << tangent_automatic;
-      // Residuals only (no Jacobian requested): the same residual.
-      Eigen::Vector2d r_only;
-      ASSERT_TRUE(analytic->Evaluate(params, r_only.data(), nullptr));
-      EXPECT_EQ(r_only, r_analytic);
+      test::ExpectSameTangentJacobian<2>(*analytic, *automatic, x.data());
     }
   }
 }

@@ -10,6 +10,7 @@
 
 #include "auvdock/geometry/pose3.h"
 #include "factors/pose_manifold.h"
+#include "tests/testing/tangent_jacobian_check.h"
 
 namespace auvdock {
 namespace {
@@ -103,10 +104,10 @@ TEST(StereoPointFactorTest, JacobiansPassTheGradientCheckerWithThePoseManifold) 
 }
 
 // The analytic Jacobian (Create) against ceres::Jet's (CreateAutoDiff) in the tangent space
-// (ambient Jacobian times the manifold's PlusJacobian); and the residuals equal.
+// (ambient Jacobian times the manifold's PlusJacobian); and the residuals equal
+// (tests/testing/tangent_jacobian_check.h).
 TEST(StereoPointFactorTest, AnalyticJacobianEqualsAutomaticDifferentiation) {
   const Pose3 T_B_S = ForwardDownExtrinsic();
-  const PoseManifold manifold;
   for (const Pose3& T_D_B : TestPoses()) {
     const Eigen::Vector3d p_S_true(-0.4, 0.25, 2.5);
     const Eigen::Vector3d p_D_L = T_D_B * (T_B_S * p_S_true);
@@ -116,20 +117,7 @@ TEST(StereoPointFactorTest, AnalyticJacobianEqualsAutomaticDifferentiation) {
     std::unique_ptr<ceres::CostFunction> automatic(StereoPointFactor::CreateAutoDiff(
         std::make_unique<StereoPointFactor>(p_S, StereoCovariance(), T_B_S, p_D_L, 1.5)));
     const Vector7 x = ToBlock(T_D_B);
-    const double* params[1] = {x.data()};
-    Eigen::Vector3d r_analytic, r_automatic;
-    Eigen::Matrix<double, 3, 7, Eigen::RowMajor> J_analytic, J_automatic;
-    double* jacobians_analytic[1] = {J_analytic.data()};
-    double* jacobians_automatic[1] = {J_automatic.data()};
-    ASSERT_TRUE(analytic->Evaluate(params, r_analytic.data(), jacobians_analytic));
-    ASSERT_TRUE(automatic->Evaluate(params, r_automatic.data(), jacobians_automatic));
-    EXPECT_LT((r_analytic - r_automatic).norm(), 1e-9 * (1.0 + r_automatic.norm()));
-    Eigen::Matrix<double, 7, 6, Eigen::RowMajor> plus;
-    ASSERT_TRUE(manifold.PlusJacobian(x.data(), plus.data()));
-    const Eigen::Matrix<double, 3, 6> tangent_analytic = J_analytic * plus;
-    const Eigen::Matrix<double, 3, 6> tangent_automatic = J_automatic * plus;
-    EXPECT_LT((tangent_analytic - tangent_automatic).norm(), 1e-9 * tangent_automatic.norm())
-        << "analytic\n" << tangent_analytic << "\nautomatic\n" << tangent_automatic;
+    test::ExpectSameTangentJacobian<3>(*analytic, *automatic, x.data());
   }
 }
 
