@@ -53,7 +53,8 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
   summary["adaptive_variance_factor"] = {{"mono", stats.mono_variance_factor},
                                          {"stereo", stats.stereo_variance_factor},
                                          {"dvl", stats.dvl_variance_factor},
-                                         {"depth", stats.depth_variance_factor}};
+                                         {"depth", stats.depth_variance_factor},
+                                         {"sbl", stats.sbl_variance_factor}};
   summary["resets"] = stats.resets;
   summary["init_refused"] = stats.init_refused;
   summary["solver_failures"] = stats.solver_failures;

@@ -91,7 +91,7 @@ void Smooth(const SmoothOptions& options) {
       config.estimator, batch,
       NavigationSamples{dataset.depth, dataset.dvl, estimator.stats().dvl_variance_factor,
                         estimator.stats().depth_variance_factor, dataset.acoustic,
-                        dataset.sbl});
+                        dataset.sbl, estimator.stats().sbl_variance_factor});
   counters.backend_s += Seconds(Clock::now() - t0);
   if (!options.quiet) std::fprintf(stderr, "\n");
 

@@ -68,11 +68,14 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
                      options.dvl_rate_test),
       dvl_noise_(options.adaptive_dvl_noise),
       depth_noise_(options.adaptive_depth_noise),
+      sbl_noise_(options.adaptive_sbl_noise),
       usbl_rate_test_(options.usbl_rate_test) {
   if (calibration_.sbl) {
     UsblRateTestOptions sbl_rate = options.usbl_rate_test;
     sbl_rate.enabled = options.sbl_rate_test;
-    sbl_rate_tests_.assign(calibration_.sbl->p_B_transducers.size(), UsblRateTest(sbl_rate));
+    const size_t n_transducers = calibration_.sbl->p_B_transducers.size();
+    sbl_rate_tests_.assign(n_transducers, UsblRateTest(sbl_rate));
+    sbl_innovations_.assign(n_transducers, SecondDifference(options.sbl_range_innovation));
   }
   if (options_.window_size < 2 || options_.max_solver_iterations < 1 ||
       !(options_.vision.huber_sigmas > 0.0) || !(options_.max_imu_gap_s > 0.0) ||
@@ -270,8 +273,9 @@ void SlidingWindowEstimator::AddDepth(const DepthMeasurement& sample) {
   }
   last_depth_sample_t_ns_ = sample.t_ns;
   if (const std::optional<double> statistic =
-          depth_innovation_.Add(sample, calibration_.depth->sigma_m, depth_noise_.factor())) {
-    depth_noise_.Update(std::min(*statistic, options_.depth_gate_chi2), 1.0);
+          depth_innovation_.Add(sample.t_ns, sample.depth_m, calibration_.depth->sigma_m,
+                                depth_noise_.factor())) {
+    depth_noise_.UpdateCensored(*statistic, 1, options_.depth_gate_chi2);
     stats_.depth_variance_factor = depth_noise_.factor();
   }
   pending_depth_.push_back(sample);
@@ -328,6 +332,11 @@ void SlidingWindowEstimator::AddSblRange(const SblRange& range) {
                                verdict.reason});
     return;
   }
+  if (const std::optional<double> statistic = sbl_innovations_[range.transducer].Add(
+          range.t_ns, range.range_m, range.sigma_m, sbl_noise_.factor())) {
+    sbl_noise_.UpdateCensored(*statistic, 1, options_.sbl_gate_chi2);
+    stats_.sbl_variance_factor = sbl_noise_.factor();
+  }
   pending_sbl_.push_back(range);
 }
 
@@ -335,8 +344,10 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachSbl(int64_t t_ns) {
   if (!calibration_.sbl) return {};
   return AttachPending(&pending_sbl_, t_ns, calibration_.sbl->name, &stats_.sbl_skipped,
                        [&](const SblRange& range, State& state) {
+                         SblRange scaled = range;
+                         scaled.sigma_m *= std::sqrt(sbl_noise_.factor());
                          const std::optional<ceres::ResidualBlockId> id =
-                             AddSblFactor(problem_.get(), range, *calibration_.sbl, dock_,
+                             AddSblFactor(problem_.get(), scaled, *calibration_.sbl, dock_,
                                           BlocksOf(state), state.t_ns,
                                           options_.sensor_huber_sigmas);
                          if (id) sbl_transducer_of_[*id] = range.transducer;
@@ -437,7 +448,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
             dvl_rate_test_.Check(sample, imu_, blocks.bias,
                                  PoseFromBlock(state->pose).q * shift->delta_q, dock_.gravity_D);
         if (std::isfinite(verdict.statistic)) {
-          dvl_noise_.Update(std::min(verdict.statistic, options_.dvl_rate_test.gate_chi2), 3.0);
+          dvl_noise_.UpdateCensored(verdict.statistic, 3, options_.dvl_rate_test.gate_chi2);
           stats_.dvl_variance_factor = dvl_noise_.factor();
         }
         if (!verdict.pass) {

@@ -2,6 +2,7 @@
 // the factor in use, stays within its bounds, and does nothing when disabled.
 #include "auvdock/estimator/adaptive_noise_scale.h"
 
+#include <algorithm>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -62,6 +63,69 @@ TEST(AdaptiveNoiseScale, WaitsForEnoughDataAndCanBeOff) {
   scale.Update(-1.0, 2.0);  // ignored: not a squared residual
   scale.Update(1.0, 0.0);   // ignored: no redundancy
   EXPECT_EQ(scale.redundancy_seen(), 2.0);
+}
+
+TEST(ChiSquareCdf, KnownValues) {
+  // Tabulated quantiles (p = 0.95, 0.999) and the medians.
+  EXPECT_NEAR(ChiSquareCdf(1, 3.841), 0.95, 1e-4);
+  EXPECT_NEAR(ChiSquareCdf(1, 10.83), 0.999, 1e-4);
+  EXPECT_NEAR(ChiSquareCdf(2, 5.991), 0.95, 1e-4);
+  EXPECT_NEAR(ChiSquareCdf(3, 16.27), 0.999, 1e-4);
+  EXPECT_NEAR(ChiSquareCdf(3, 2.366), 0.5, 1e-3);
+  EXPECT_NEAR(ChiSquareCdf(6, 12.59), 0.95, 1e-4);
+  EXPECT_NEAR(ChiSquareCdf(7, 14.07), 0.95, 1e-4);
+  EXPECT_EQ(ChiSquareCdf(3, 0.0), 0.0);
+  EXPECT_EQ(ChiSquareCdf(3, -1.0), 0.0);
+  EXPECT_NEAR(ChiSquareCdf(1, 1e6), 1.0, 1e-12);
+}
+
+// Statistics lambda chi2_dof (whitened by the factor in use), a share `outliers` of them far
+// out (a multipath reply), fed to UpdateCensored with the cutoff c.
+double ConvergeCensored(double true_factor, int dof, double outliers, double cutoff) {
+  AdaptiveNoiseScale scale(AdaptiveNoiseOptions{true, 100.0});
+  std::mt19937_64 rng(5);
+  std::chi_squared_distribution<double> chi2(dof);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 20000; ++i) {
+    const double statistic =
+        u(rng) < outliers ? 1e4 : true_factor * chi2(rng) / scale.factor();
+    scale.UpdateCensored(statistic, dof, cutoff);
+  }
+  return scale.factor();
+}
+
+TEST(AdaptiveNoiseScale, CensoredUpdateIgnoresOutliersAndKeepsTheTrueFactor) {
+  for (const int dof : {1, 3}) {
+    const double cutoff = dof == 1 ? 10.83 : 16.27;
+    EXPECT_NEAR(ConvergeCensored(1.0, dof, 0.0, cutoff), 1.0, 0.15) << dof;
+    EXPECT_NEAR(ConvergeCensored(1.0, dof, 0.06, cutoff), 1.0, 0.15) << dof;
+    EXPECT_NEAR(ConvergeCensored(9.0, dof, 0.06, cutoff) / 9.0, 1.0, 0.15) << dof;
+    EXPECT_NEAR(ConvergeCensored(0.36, dof, 0.0, cutoff) / 0.36, 1.0, 0.15) << dof;
+    // A cutoff at p = 0.95 leaves 5 % of the good statistics out, and the truncated mean
+    // corrects for it (kept statistics average 0.76 of dof 1's mean, 0.88 of dof 3's).
+    const double cutoff95 = dof == 1 ? 3.841 : 7.815;
+    EXPECT_NEAR(ConvergeCensored(1.0, dof, 0.0, cutoff95), 1.0, 0.15) << dof;
+    EXPECT_NEAR(ConvergeCensored(4.0, dof, 0.0, cutoff95) / 4.0, 1.0, 0.15) << dof;
+  }
+  // Clipping at the cutoff instead (what UpdateCensored replaces) is biased by the outliers.
+  AdaptiveNoiseScale clipped(AdaptiveNoiseOptions{true, 100.0});
+  std::mt19937_64 rng(5);
+  std::chi_squared_distribution<double> chi2(1);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 20000; ++i) {
+    const double statistic = u(rng) < 0.06 ? 1e4 : chi2(rng) / clipped.factor();
+    clipped.Update(std::min(statistic, 10.83), 1.0);
+  }
+  EXPECT_GT(clipped.factor(), 1.4);
+}
+
+TEST(AdaptiveNoiseScale, CensoredUpdateCountsWhatItLeavesOut) {
+  AdaptiveNoiseScale scale;
+  scale.UpdateCensored(20.0, 1, 10.83);
+  scale.UpdateCensored(1.0, 1, 10.83);
+  scale.UpdateCensored(-1.0, 1, 10.83);  // ignored: not a statistic
+  EXPECT_EQ(scale.censored(), 1);
+  EXPECT_EQ(scale.redundancy_seen(), 1.0);
 }
 
 }  // namespace

@@ -618,6 +618,86 @@ TEST(SlidingWindowEstimatorTest, SblRangesHoldThePositionWithoutVisionAndAMultip
   EXPECT_LT(max_xy[1], 0.6 * max_xy[0]);
 }
 
+// SBL ranges three times noisier than their sigma says, 2 % of them multipath replies 0.5-1 m
+// long: the array's variance factor (each transducer's second difference, second_difference.h,
+// the multipath ones left out: AdaptiveNoiseScale::UpdateCensored) finds about 9, and about 1
+// when they are as configured; the ranges' gate follows it, so few good ranges are gated. The
+// factor is an average over ~100 statistics (the adaptation's time constant), so each run's is
+// good to about +-10 % (1 sigma): four noise draws, each within [0.6, 1.5] of the truth, their
+// mean within [0.8, 1.2] when as configured; from 1 toward 9 the censored factor climbs for
+// most of the 40 s (the statistics above the cutoff are left out), so its mean is held to
+// [0.7, 1.2] there.
+TEST(SlidingWindowEstimatorTest, SblRangesNoisierThanConfiguredAreFound) {
+  AcousticLanding landing = MakeAcousticLanding([](size_t) { return 0.0; }, 40.0, 30.0);
+  test::SyntheticRun& run = landing.run;
+  SblCalibration sbl;
+  sbl.p_B_transducers = {{0.4, -0.15, 0.2}, {0.4, 0.15, 0.2}, {-0.4, 0.15, 0.2}, {-0.4, -0.15, 0.2}};
+  run.calibration.sbl = sbl;
+  const auto run_with = [&](double truth_sigma, uint64_t seed, bool adapt) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> noise(0.0, truth_sigma);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    std::vector<SblRange> ranges;
+    int multipath = 0;
+    for (size_t k = 3; k < run.truth.size(); k += 5) {
+      for (int t = 0; t < 4; ++t) {
+        double range = (run.truth[k].T_D_B * sbl.p_B_transducers[t] - run.dock.p_D_beacon).norm() +
+                       noise(rng);
+        if (uniform(rng) < 0.02) {
+          range += 0.5 + 0.5 * uniform(rng);
+          ++multipath;
+        }
+        ranges.push_back({run.truth[k].t_ns + 10'000'000, t, range, 0.02});
+      }
+    }
+    EstimatorOptions options;
+    options.use_usbl = false;
+    options.adaptive_sbl_noise.enabled = adapt;
+    SlidingWindowEstimator estimator(run.calibration, run.dock, options);
+    size_t next_imu = 0, next_range = 0;
+    for (const VisionFrame& frame : run.frames) {
+      while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= frame.t_ns) {
+        estimator.AddImu(run.imu[next_imu++]);
+      }
+      while (next_range < ranges.size() && ranges[next_range].t_ns <= frame.t_ns) {
+        estimator.AddSblRange(ranges[next_range++]);
+      }
+      estimator.AddVisionFrame(frame);
+    }
+    EXPECT_GT(estimator.stats().sbl_used, 0);
+    return std::make_tuple(estimator.stats(), ranges.size(), multipath);
+  };
+  for (const double truth_sigma : {0.06, 0.02}) {
+    const double expected = std::pow(truth_sigma / 0.02, 2);
+    double sum_ratio = 0.0;
+    const std::vector<uint64_t> seeds = {8, 9, 10, 11};
+    for (const uint64_t seed : seeds) {
+      const auto [stats, n_ranges, multipath] = run_with(truth_sigma, seed, true);
+      const double ratio = stats.sbl_variance_factor / expected;
+      std::printf("SBL sigma %.2f m, configured 0.02 m, draw %d: factor %.2f (expected %.1f), "
+                  "%d of %zu ranges gated, %d multipath\n",
+                  truth_sigma, static_cast<int>(seed), stats.sbl_variance_factor, expected,
+                  stats.sbl_gated, n_ranges, multipath);
+      EXPECT_GT(ratio, 0.6) << truth_sigma << " draw " << seed;
+      EXPECT_LT(ratio, 1.5) << truth_sigma << " draw " << seed;
+      EXPECT_GE(stats.sbl_gated + stats.sbl_rate_rejected, multipath) << truth_sigma;
+      // Good ranges gated: under 5 % as configured; under 6 % when 3x noisier, most while the
+      // factor climbs (27 % without adaptation, below).
+      const int allowed = static_cast<int>(n_ranges) / (truth_sigma > 0.02 ? 16 : 20);
+      EXPECT_LT(stats.sbl_gated, multipath + allowed) << truth_sigma;
+      sum_ratio += ratio;
+    }
+    const double mean_ratio = sum_ratio / static_cast<double>(seeds.size());
+    EXPECT_GT(mean_ratio, truth_sigma > 0.02 ? 0.7 : 0.8) << truth_sigma;
+    EXPECT_LT(mean_ratio, 1.2) << truth_sigma;
+  }
+  // Without adaptation ranges 3 sigma wide against a 1-sigma model fail the gate (|e| above 3.3
+  // configured sigmas: 27 % of them).
+  const auto [fixed, n_ranges, multipath] = run_with(0.06, 8, false);
+  EXPECT_EQ(fixed.sbl_variance_factor, 1.0);
+  EXPECT_GT(fixed.sbl_gated, static_cast<int>(n_ranges) / 10);
+}
+
 // Fixes that arrive 0.3-1.2 s after their measurement, fed only on arrival (causal), on the
 // approach at ~0.5 m/s with the lights lost after 5 s: those whose time is still in the window
 // (0.9 s) attach inside it, older ones to its oldest state through the IMU backward. At each

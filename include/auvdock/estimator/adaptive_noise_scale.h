@@ -10,13 +10,22 @@
 // has expectation lambda (m - leverage), and lambda is estimated as the ratio of exponential
 // moving averages of q and of (m - leverage), with time constant `time_constant` measurements:
 // slow, so that one bad frame does not move it, and never outside [min_factor, max_factor].
-// Used for each camera system's centroid noise now, meant for every sensor (depth, DVL,
-// acoustic): one mechanism.
+// Used for each camera system's centroid noise (post-solve residuals) and for the depth, DVL
+// and SBL noise (state-free innovations: second_difference.h, dvl_rate_test.h): one mechanism.
+//
+// A state-free innovation test sees the sensor's outliers too (a pressure spike, a DVL lock on
+// a fish, an SBL multipath reply): UpdateCensored leaves out a statistic above the test's cutoff
+// c instead of clipping it to c (clipped, 2 % SBL multipath gave a factor of 1.3-2.5 on ranges
+// exactly as configured), and divides each kept statistic by the mean of the truncated
+// distribution, E[chi2_m | chi2_m < c] / m = P_{m+2}(c) / P_m(c) (P_k: the chi-square CDF with
+// k dof), so that the true factor stays the fixed point. From a factor far too small most
+// statistics are above c and the factor climbs a few time constants, not one.
 //
 // Units: none (a ratio of variances). Not thread-safe; one per sensor.
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
 
 namespace auvdock {
 
@@ -45,7 +54,12 @@ class AdaptiveNoiseScale {
     }
   }
 
+  // One statistic that is chi-square with `dof` degrees of freedom when the factor in use is
+  // right (whitened by it), left out when above `cutoff` (> 0), see above.
+  void UpdateCensored(double statistic, int dof, double cutoff);
+
   double factor() const { return factor_; }
+  int64_t censored() const { return censored_; }
   double redundancy_seen() const { return seen_; }
 
  private:
@@ -53,6 +67,12 @@ class AdaptiveNoiseScale {
   double factor_ = 1.0;
   double sum_q_ = 1.0;  // EMA of q / redundancy, started at the configured noise
   double seen_ = 0.0;
+  int64_t censored_ = 0;
 };
+
+// P(chi2_dof < x), for dof >= 1: the recurrence
+//   P_{k+2}(x) = P_k(x) - (x/2)^(k/2) e^(-x/2) / Gamma(k/2 + 1)
+// from P_1(x) = erf(sqrt(x/2)) and P_2(x) = 1 - e^(-x/2).
+double ChiSquareCdf(int dof, double x);
 
 }  // namespace auvdock

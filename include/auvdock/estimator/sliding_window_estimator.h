@@ -53,10 +53,10 @@
 #include "auvdock/estimator/imu_buffer.h"
 #include "auvdock/estimator/stage_weighting.h"
 #include "auvdock/estimator/adaptive_noise_scale.h"
-#include "auvdock/estimator/depth_second_difference.h"
 #include "auvdock/estimator/usbl_rate_test.h"
 #include "auvdock/estimator/dvl_rate_test.h"
 #include "auvdock/estimator/rejection.h"
+#include "auvdock/estimator/second_difference.h"
 #include "auvdock/estimator/sensor_factors.h"
 #include "auvdock/estimator/vision_factors.h"
 #include "auvdock/estimator/vision_frame.h"
@@ -129,7 +129,7 @@ struct EstimatorOptions {
   // DVL factor's variance (and so the gate's). Needs dvl_rate_test.
   AdaptiveNoiseOptions adaptive_dvl_noise;
   // The same for the pressure depth, from the second difference of consecutive samples
-  // (depth_second_difference.h: state-free, chi-square 1 dof), each statistic counted up to
+  // (second_difference.h: state-free, chi-square 1 dof), each statistic counted up to
   // depth_gate_chi2. Time constant 100 samples (10 s at 10 Hz): one dof per sample.
   AdaptiveNoiseOptions adaptive_depth_noise = AdaptiveNoiseOptions{true, 100.0};
   // Batch smoother only (estimator/batch_smoother.h): the slowly varying part of the detection
@@ -181,6 +181,13 @@ struct EstimatorOptions {
   // The rate-of-change test per transducer (usbl_rate_test.h, with usbl_rate_test's speed and
   // gate): a multipath reply that lengthens a range faster than the vehicle moves.
   bool sbl_rate_test = true;
+  // The SBL ranges' variance factor (one for the array; the same mechanism), from each
+  // transducer's second difference of its ranges that passed the rate test (second_difference.h,
+  // sbl_range_innovation: a slant range's own curvature under 0.1 m/s^2 at docking speeds), each
+  // statistic counted up to sbl_gate_chi2. It scales every range's sigma, in the factor and so in
+  // the gate. Time constant 100 statistics (about 15 s at 2 pings a second and 4 transducers).
+  AdaptiveNoiseOptions adaptive_sbl_noise = AdaptiveNoiseOptions{true, 100.0};
+  SecondDifferenceOptions sbl_range_innovation = SecondDifferenceOptions{0.03, 2.5};
   // Multiplies the calibration's IMU noise densities and random walks (sigma, not variance).
   // Datasheet values are measured on a bench, at constant temperature, without vibration; on a
   // vehicle the effective noise is larger (a real EuRoC sequence gives a chi-square about 100x
@@ -245,6 +252,7 @@ struct EstimatorStats {
   std::map<int, double> stereo_variance_factor;
   double dvl_variance_factor = 1.0;  // adaptive_dvl_noise's factor in use at the end
   double depth_variance_factor = 1.0;  // adaptive_depth_noise's
+  double sbl_variance_factor = 1.0;    // adaptive_sbl_noise's
   std::vector<std::string> log;  // one line per skip/reset, for the caller's log
 };
 
@@ -356,7 +364,9 @@ class SlidingWindowEstimator {
   DvlRateTest dvl_rate_test_;
   AdaptiveNoiseScale dvl_noise_;  // the DVL's variance factor (adaptive_dvl_noise)
   AdaptiveNoiseScale depth_noise_;  // the depth's (adaptive_depth_noise)
-  DepthSecondDifference depth_innovation_;
+  SecondDifference depth_innovation_;
+  AdaptiveNoiseScale sbl_noise_;                    // the SBL ranges' (adaptive_sbl_noise)
+  std::vector<SecondDifference> sbl_innovations_;  // one per transducer
   UsblRateTest usbl_rate_test_;
   std::vector<UsblRateTest> sbl_rate_tests_;  // one per transducer
   std::map<ceres::ResidualBlockId, int> sbl_transducer_of_;  // the newest frame's SBL residuals
