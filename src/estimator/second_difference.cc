@@ -9,7 +9,7 @@ std::optional<double> SecondDifference::Add(int64_t t_ns, double value, double s
   if (!std::isfinite(value) || !std::isfinite(sigma) || !(sigma > 0.0)) return std::nullopt;
   if (count_ > 0 && t_ns <= t_[count_ - 1]) return std::nullopt;
   if (count_ > 0 && 1e-9 * static_cast<double>(t_ns - t_[count_ - 1]) > options_.max_span_s) {
-    count_ = 0;
+    Reset();
   }
   std::optional<double> statistic;
   if (count_ == 2 && 1e-9 * static_cast<double>(t_ns - t_[0]) <= options_.max_span_s) {
@@ -35,7 +35,23 @@ std::optional<double> SecondDifference::Add(int64_t t_ns, double value, double s
   z_[count_] = value;
   s_[count_] = sigma;
   ++count_;
-  return statistic;
+  return options_.outlier_cutoff > 0.0 ? Screen(statistic) : statistic;
+}
+
+std::optional<double> SecondDifference::Screen(std::optional<double> statistic) {
+  if (!statistic) return std::nullopt;
+  if (*statistic > options_.outlier_cutoff) {
+    held_.reset();
+    drop_next_ = true;
+    return std::nullopt;
+  }
+  if (drop_next_) {
+    drop_next_ = false;
+    return std::nullopt;
+  }
+  const std::optional<double> released = held_;
+  held_ = statistic;
+  return released;
 }
 
 }  // namespace auvdock

@@ -70,12 +70,18 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
       depth_noise_(options.adaptive_depth_noise),
       sbl_noise_(options.adaptive_sbl_noise),
       usbl_rate_test_(options.usbl_rate_test) {
+  // An outlier's sample is kept out of the noise statistics (second_difference.h).
+  SecondDifferenceOptions depth_innovation = options.depth_innovation;
+  depth_innovation.outlier_cutoff = options.innovation_outlier_gates * options.depth_gate_chi2;
+  depth_innovation_ = SecondDifference(depth_innovation);
   if (calibration_.sbl) {
     UsblRateTestOptions sbl_rate = options.usbl_rate_test;
     sbl_rate.enabled = options.sbl_rate_test;
     const size_t n_transducers = calibration_.sbl->p_B_transducers.size();
     sbl_rate_tests_.assign(n_transducers, UsblRateTest(sbl_rate));
-    sbl_innovations_.assign(n_transducers, SecondDifference(options.sbl_range_innovation));
+    SecondDifferenceOptions sbl_innovation = options.sbl_range_innovation;
+    sbl_innovation.outlier_cutoff = options.innovation_outlier_gates * options.sbl_gate_chi2;
+    sbl_innovations_.assign(n_transducers, SecondDifference(sbl_innovation));
   }
   if (options_.window_size < 2 || options_.max_solver_iterations < 1 ||
       !(options_.vision.huber_sigmas > 0.0) || !(options_.max_imu_gap_s > 0.0) ||
@@ -275,7 +281,8 @@ void SlidingWindowEstimator::AddDepth(const DepthMeasurement& sample) {
   if (const std::optional<double> statistic =
           depth_innovation_.Add(sample.t_ns, sample.depth_m, calibration_.depth->sigma_m,
                                 depth_noise_.factor())) {
-    depth_noise_.UpdateCensored(*statistic, 1, options_.depth_gate_chi2);
+    depth_noise_.UpdateCensored(*statistic, 1,
+                               options_.innovation_outlier_gates * options_.depth_gate_chi2);
     stats_.depth_variance_factor = depth_noise_.factor();
   }
   pending_depth_.push_back(sample);
@@ -334,7 +341,8 @@ void SlidingWindowEstimator::AddSblRange(const SblRange& range) {
   }
   if (const std::optional<double> statistic = sbl_innovations_[range.transducer].Add(
           range.t_ns, range.range_m, range.sigma_m, sbl_noise_.factor())) {
-    sbl_noise_.UpdateCensored(*statistic, 1, options_.sbl_gate_chi2);
+    sbl_noise_.UpdateCensored(*statistic, 1,
+                             options_.innovation_outlier_gates * options_.sbl_gate_chi2);
     stats_.sbl_variance_factor = sbl_noise_.factor();
   }
   pending_sbl_.push_back(range);
@@ -448,7 +456,9 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
             dvl_rate_test_.Check(sample, imu_, blocks.bias,
                                  PoseFromBlock(state->pose).q * shift->delta_q, dock_.gravity_D);
         if (std::isfinite(verdict.statistic)) {
-          dvl_noise_.UpdateCensored(verdict.statistic, 3, options_.dvl_rate_test.gate_chi2);
+          dvl_noise_.UpdateCensored(
+              verdict.statistic, 3,
+              options_.innovation_outlier_gates * options_.dvl_rate_test.gate_chi2);
           stats_.dvl_variance_factor = dvl_noise_.factor();
         }
         if (!verdict.pass) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -82,6 +83,29 @@ TEST(SecondDifference, AGapRestartsAndABackwardOrInvalidSampleIsIgnored) {
   EXPECT_FALSE(innovation.Add(Ns(5.3), 30.0, 0.0, 1.0));
   EXPECT_FALSE(innovation.Add(Ns(5.3), 30.0, -0.02, 1.0));
   EXPECT_TRUE(innovation.Add(Ns(5.3), 30.0, 0.02, 1.0));  // the invalid ones left no trace
+}
+
+// One outlier among constant samples: it is in three triples; the middle one's statistic (4x)
+// is above the cutoff, and none of the three is returned, while the clean ones are, one late.
+TEST(SecondDifference, AnOutlierSampleIsKeptOutOfAllThreeOfItsTriples) {
+  SecondDifferenceOptions options;
+  options.accel_sigma = 0.0;
+  options.outlier_cutoff = 43.0;
+  SecondDifference innovation(options);
+  SecondDifference plain(SecondDifferenceOptions{0.0, 1.0});
+  std::vector<int> returned, plain_large;
+  for (int k = 0; k < 12; ++k) {
+    // 0.2 m on a 0.02 m sigma at sample 6: 0.2^2 / (6 0.02^2) = 16.7 beside, 67 in the middle.
+    const double z = 10.0 + (k == 6 ? 0.2 : 0.001 * (k % 2));
+    if (innovation.Add(Ns(0.5 * k), z, 0.02, 1.0)) returned.push_back(k);
+    const std::optional<double> s = plain.Add(Ns(0.5 * k), z, 0.02, 1.0);
+    if (s && *s > 10.0) plain_large.push_back(k);
+  }
+  // Triples end at samples 2..11; those ending at 6, 7, 8 hold the outlier. Each statistic is
+  // returned with the next sample: those of the triples ending at 2-5 at 3-6, at 9-10 at 10-11
+  // (the one ending at 5 is returned at 6, before the outlier shows).
+  EXPECT_EQ(returned, (std::vector<int>{3, 4, 5, 6, 10, 11}));
+  EXPECT_EQ(plain_large, (std::vector<int>{6, 7, 8}));  // all three stand out without the screen
 }
 
 }  // namespace

@@ -15,6 +15,13 @@
 // The statistic d^2 / Var d is chi-square with 1 dof when lambda is right, whatever the state's
 // estimate. Samples more than max_span_s apart (a gap) restart the triple; a sample not later
 // than the previous one, or not finite, is ignored. Units: those of the samples (m), s.
+//
+// Outliers (outlier_cutoff > 0): one bad sample z_k (an SBL multipath reply, a pressure spike)
+// is in three triples, with weights 1, -2, 1: the middle one's statistic is 4x the others', so
+// it is the one that shows the outlier, while the two beside it may look like plain noise and
+// would bias the noise estimate. So a statistic above the cutoff is not returned, and neither
+// are the one before it and the one after it; to allow that, each statistic is returned one
+// sample late (and the one held at a gap is dropped).
 #pragma once
 
 #include <cstdint>
@@ -25,6 +32,7 @@ namespace auvdock {
 struct SecondDifferenceOptions {
   double accel_sigma = 0.1;  // of the quantity's second derivative (m/s^2)
   double max_span_s = 1.0;
+  double outlier_cutoff = 0.0;  // statistic above which a sample is an outlier; 0: none
 };
 
 class SecondDifference {
@@ -33,17 +41,27 @@ class SecondDifference {
 
   // The statistic of the triple ending with this sample (value, with its configured sigma > 0, at
   // t_ns), for the variance factor lambda in use; nullopt until there are three samples within
-  // max_span_s. The sample then becomes the newest of the triple.
+  // max_span_s. The sample then becomes the newest of the triple. With outlier_cutoff, the
+  // statistic of the triple before (see above), or nullopt when it is left out.
   std::optional<double> Add(int64_t t_ns, double value, double sigma, double lambda);
 
-  void Reset() { count_ = 0; }
+  void Reset() {
+    count_ = 0;
+    held_.reset();
+    drop_next_ = false;
+  }
 
  private:
+  // The outlier screen: the statistic to return for this one (see above).
+  std::optional<double> Screen(std::optional<double> statistic);
+
   SecondDifferenceOptions options_;
   int64_t t_[2] = {0, 0};  // the two previous samples, older first
   double z_[2] = {0.0, 0.0};
   double s_[2] = {0.0, 0.0};
   int count_ = 0;          // how many of them are held (0-2)
+  std::optional<double> held_;  // with outlier_cutoff: the statistic not yet returned
+  bool drop_next_ = false;      // the next statistic shares an outlier's sample
 };
 
 }  // namespace auvdock

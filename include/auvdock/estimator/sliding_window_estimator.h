@@ -123,15 +123,25 @@ struct EstimatorOptions {
   // rate-of-change test's innovations (dvl_rate_test.h): the difference of two samples against
   // the IMU's velocity change, whose statistic has the expectation 3 when the configured sigma
   // is right, and which does not depend on the state's estimate (so no leverage: redundancy 3).
-  // Each statistic counts up to the test's gate (a spike moves the factor by no more than a
-  // sample at the gate), so a DVL much noisier than configured, whose samples first mostly fail
-  // the test, still raises the factor until they pass. The factor sets the rate test's and the
-  // DVL factor's variance (and so the gate's). Needs dvl_rate_test.
+  // A statistic above innovation_outlier_gates x the test's gate is an outlier (a spike) and
+  // left out, AdaptiveNoiseScale::UpdateCensored; one between the gate and that still counts,
+  // so a DVL much noisier than configured, whose samples first mostly fail the test, raises the
+  // factor until they pass. The factor sets the rate test's and the DVL factor's variance (and
+  // so the gate's). Needs dvl_rate_test.
   AdaptiveNoiseOptions adaptive_dvl_noise;
   // The same for the pressure depth, from the second difference of consecutive samples
-  // (second_difference.h: state-free, chi-square 1 dof), each statistic counted up to
+  // (second_difference.h: state-free, chi-square 1 dof), censored at innovation_outlier_gates x
   // depth_gate_chi2. Time constant 100 samples (10 s at 10 Hz): one dof per sample.
   AdaptiveNoiseOptions adaptive_depth_noise = AdaptiveNoiseOptions{true, 100.0};
+  SecondDifferenceOptions depth_innovation;  // a docking AUV's vertical acceleration: 0.1 m/s^2
+  // The cutoff of those state-free statistics, in gates: above it a statistic is an outlier,
+  // left out of the factor. Clipped at the gate instead, 2 % SBL multipath (0.5-1 m) gave a
+  // factor of 1.3-2.5 on ranges as configured; censored at the gate itself, a DVL 3x noisier
+  // than configured took most of a run to be found (61 % of its statistics above the gate
+  // while the factor is 1). At 4 gates (43 for 1 dof, 65 for 3) a multipath range or a DVL
+  // spike is far beyond, and 3x noise mostly below. A second difference's outlier also takes
+  // the statistics beside it out (second_difference.h): they share the bad sample.
+  double innovation_outlier_gates = 4.0;
   // Batch smoother only (estimator/batch_smoother.h): the slowly varying part of the detection
   // errors, per pixel coordinate (1-sigma, px) and its correlation time (s); either 0 = white
   // errors only. The sliding window ignores them. README, "Vision noise".
@@ -183,9 +193,11 @@ struct EstimatorOptions {
   bool sbl_rate_test = true;
   // The SBL ranges' variance factor (one for the array; the same mechanism), from each
   // transducer's second difference of its ranges that passed the rate test (second_difference.h,
-  // sbl_range_innovation: a slant range's own curvature under 0.1 m/s^2 at docking speeds), each
-  // statistic counted up to sbl_gate_chi2. It scales every range's sigma, in the factor and so in
-  // the gate. Time constant 100 statistics (about 15 s at 2 pings a second and 4 transducers).
+  // sbl_range_innovation: accel_sigma 0.03 m/s^2 for the slant range's own curvature, 0.01-0.02 m
+  // of second difference over 0.5 s on the default approach against 0.05 m of noise), censored
+  // at innovation_outlier_gates x sbl_gate_chi2. It scales every range's sigma, in the factor and
+  // so in the gate. Time constant 100 statistics (about 15 s at 2 pings a second and 4
+  // transducers).
   AdaptiveNoiseOptions adaptive_sbl_noise = AdaptiveNoiseOptions{true, 100.0};
   SecondDifferenceOptions sbl_range_innovation = SecondDifferenceOptions{0.03, 2.5};
   // Multiplies the calibration's IMU noise densities and random walks (sigma, not variance).
