@@ -110,26 +110,27 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
   }
   // 4. No pose: once more with laxer thresholds, keeping what the dock model verifies.
   if (!frame.pose.T_C_D && options_.weak_pass &&
-      frame.first_pass_detections < options_.poser.min_lights) {
+      (frame.first_pass_detections < options_.poser.min_lights ||
+       options_.weak_pass_after_failed_identification)) {
     std::vector<LightDetection> weak =
         weak_detector_.Detect(image, nullptr, options_.weak_halo_fraction * halo);
     // The strongest few only: hypothesise-and-verify over many weak blobs costs more than the
     // rest of the frame (and clutter can fit a layout).
-    const size_t most = dock_.lights.size() + 2;
+    const size_t most = dock_.lights.size() + 4;
     if (weak.size() > most) weak.resize(most);
     if (weak.size() > static_cast<size_t>(frame.first_pass_detections)) {
       const auto t3 = Clock::now();
-      MonoPoseResult retry = poser_.Retry(weak);
-      frame.identify_s += Seconds(t3, Clock::now());
       // A pose from weak blobs must explain most of the dock it puts in view (clutter can fit a
-      // few lights of a layout, rarely most of them).
-      const auto in_view = [&](const Pose3& T_C_D) {
-        return PredictLights(dock_, camera_.intrinsics, T_C_D, Eigen::Matrix<double, 6, 6>::Zero(),
-                             {})
-            .size();
+      // few lights of a layout, rarely most of them); one that does not is not tracked from.
+      const auto explains_most = [&](const MonoPoseResult& r) {
+        const size_t in_view = PredictLights(dock_, camera_.intrinsics, *r.T_C_D,
+                                             Eigen::Matrix<double, 6, 6>::Zero(), {})
+                                   .size();
+        return r.num_lights >= options_.weak_min_support * static_cast<double>(in_view);
       };
-      if (retry.T_C_D && retry.num_lights >= options_.weak_min_support *
-                                                 static_cast<double>(in_view(*retry.T_C_D))) {
+      MonoPoseResult retry = poser_.Retry(weak, explains_most);
+      frame.identify_s += Seconds(t3, Clock::now());
+      if (retry.T_C_D) {
         std::vector<LightDetection> kept;
         std::vector<int> ids;
         for (size_t i = 0; i < weak.size(); ++i) {

@@ -22,8 +22,22 @@ MonoPoseResult MonoLightPoser::ProcessTrackedOnly(const std::vector<LightDetecti
   return Solve(detections, /*from_scratch=*/false);
 }
 
-MonoPoseResult MonoLightPoser::Retry(const std::vector<LightDetection>& detections) {
-  return Solve(detections, /*from_scratch=*/true);
+MonoPoseResult MonoLightPoser::Retry(const std::vector<LightDetection>& detections,
+                                     const std::function<bool(const MonoPoseResult&)>& accept) {
+  const std::optional<Pose3> last_T_C_D = last_T_C_D_;
+  const int frames_since_pose = frames_since_pose_;
+  MonoPoseResult result = Solve(detections, /*from_scratch=*/true);
+  if (result.T_C_D && accept && !accept(result)) {
+    last_T_C_D_ = last_T_C_D;
+    frames_since_pose_ = frames_since_pose;
+    MonoPoseResult refused;
+    refused.light_ids.assign(detections.size(), -1);
+    refused.pixel_sigma_px = result.pixel_sigma_px;
+    refused.reason = "a pose of " + std::to_string(result.num_lights) +
+                     " lights, refused (too little of the dock)";
+    return refused;
+  }
+  return result;
 }
 
 std::optional<Pose3> MonoLightPoser::TrackedPose() const {

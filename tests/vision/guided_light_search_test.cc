@@ -260,6 +260,70 @@ TEST(MonoLightPipeline, ATrackedPoseFindsTheLightThatFaded) {
   EXPECT_TRUE(found);
 }
 
+// Two bright lights and two bright clutter blobs make min_lights first-pass detections that no
+// pose explains; the dock's four dim lights are found by the laxer pass, which now also follows
+// a failed identification (weak_pass_after_failed_identification), and settle it.
+TEST(MonoLightPipeline, AFailedIdentificationGetsTheLaxerPassToo) {
+  const CameraCalibration camera = MonoCalibration();
+  const DockModel dock = test::LoadDock("t_shape.yaml");
+  const Pose3 T_C_D = ViewFromAbove(6.0);
+  std::vector<std::pair<int, double>> lights;
+  for (size_t i = 0; i < dock.lights.size(); ++i) {
+    lights.emplace_back(dock.lights[i].id, i == 0 || i == 3 ? 150.0 : 40.0);
+  }
+  cv::Mat background = Background(camera.intrinsics, 11);
+  for (const Eigen::Vector2d& clutter : {Eigen::Vector2d(80, 400), Eigen::Vector2d(560, 90)}) {
+    AddGaussianBlob(clutter, 2.5, Eigen::Vector3d(150, 150, 30), &background);
+  }
+  const cv::Mat image = DrawLights(background, dock, camera.intrinsics, T_C_D, lights, 2.5, 11);
+  MonoLightPipelineOptions only_after_few = PipelineOptions(true);
+  only_after_few.weak_pass_after_failed_identification = false;
+  MonoLightPipeline before(camera, dock, only_after_few);
+  const MonoLightFrame without = before.Process(image);
+  ASSERT_EQ(without.first_pass_detections, 4);
+  EXPECT_FALSE(without.pose.T_C_D.has_value());
+
+  MonoLightPipeline pipeline(camera, dock, PipelineOptions(true));
+  const MonoLightFrame frame = pipeline.Process(image);
+  ASSERT_TRUE(frame.pose.T_C_D.has_value()) << frame.pose.reason;
+  EXPECT_TRUE(frame.from_weak_pass);
+  EXPECT_EQ(frame.pose.num_lights, static_cast<int>(dock.lights.size()));
+  EXPECT_LT((frame.pose.T_C_D->p - T_C_D.p).norm(), 0.1);
+}
+
+// A retry's pose that the caller refuses (the weak pass's: too little of the dock explained) is
+// no pose and is not tracked from: the tracking state stays that of the last accepted pose.
+TEST(MonoLightPoser, ARefusedRetryLeavesTheTrackAsItWas) {
+  const CameraCalibration camera = MonoCalibration();
+  const DockModel dock = test::LoadDock("t_shape.yaml");
+  std::mt19937_64 rng(4);
+  const test::View view = test::MakeView(dock, camera.intrinsics, ViewFromAbove(4.0),
+                                         test::AllLightIds(dock), 0, 0.2, rng);
+  MonoLightPoser poser(camera, dock);
+  ASSERT_TRUE(poser.Process(view.detections).T_C_D.has_value());
+  const Pose3 tracked = *poser.TrackedPose();
+  Pose3 elsewhere = ViewFromAbove(6.0);
+  elsewhere.q = ExpQuaternion(Eigen::Vector3d(0.0, 0.0, 1.2)) * elsewhere.q;
+  const test::View other =
+      test::MakeView(dock, camera.intrinsics, elsewhere, test::AllLightIds(dock), 0, 0.2, rng);
+  int asked = 0;
+  const MonoPoseResult refused = poser.Retry(other.detections, [&](const MonoPoseResult& r) {
+    ++asked;
+    EXPECT_TRUE(r.T_C_D.has_value());
+    return false;
+  });
+  EXPECT_EQ(asked, 1);
+  EXPECT_FALSE(refused.T_C_D.has_value());
+  EXPECT_FALSE(refused.reason.empty());
+  EXPECT_EQ(refused.light_ids, std::vector<int>(other.detections.size(), -1));
+  ASSERT_TRUE(poser.TrackedPose().has_value());
+  EXPECT_LT((poser.TrackedPose()->p - tracked.p).norm(), 1e-12);
+  const MonoPoseResult accepted =
+      poser.Retry(other.detections, [](const MonoPoseResult&) { return true; });
+  ASSERT_TRUE(accepted.T_C_D.has_value());
+  EXPECT_LT((poser.TrackedPose()->p - accepted.T_C_D->p).norm(), 1e-12);
+}
+
 // Guesses only tracking may label: a failed tracked-only frame identifies nothing from scratch
 // and leaves the tracking state as it was.
 TEST(MonoLightPoser, TrackedOnlyNeverIdentifiesFromScratchNorForgetsTheTrack) {

@@ -12,14 +12,15 @@
 //   3. Identification and pose on the detections of 1 and 2. The detections of 2 are only guesses
 //      at where a light might be, for tracking: those it did not identify are dropped, and when
 //      tracking fails, the detections of 1 alone are identified from scratch.
-//   4. No pose, from fewer than min_lights first-pass detections (an image with enough of them
-//      whose identification failed is not helped by weaker blobs: on the pool clip with a poor
-//      camera model those made wrong poses): the whole image once more with a laxer blob
-//      response and halo colour (its strongest blobs, 2 more than the dock has lights)
-//      (weak_min_response, weak_halo_fraction; the far, dim lights of a first approach), and only
-//      its detections that the identification verifies against the dock are kept (with the
-//      first pass's other detections), if its pose identifies at least weak_min_support of the
-//      lights it puts in the image.
+//   4. No pose: the whole image once more with a laxer blob response and halo colour (its
+//      strongest blobs, 4 more than the dock has lights) (weak_min_response, weak_halo_fraction;
+//      the far, dim lights of a first approach), and only its detections that the
+//      identification verifies against the dock are kept (with the first pass's other
+//      detections), if its pose identifies at least weak_min_support of the lights it puts in
+//      the image; a pose that does not is neither reported nor tracked from
+//      (MonoLightPoser::Retry's accept). Also after a first pass with min_lights detections or
+//      more whose identification failed (weak_pass_after_failed_identification): 3 lights and a
+//      bright fitting are ambiguous, the 3 dimmer lights beside them settle it.
 //   5. With a pose: the lights it projects where no detection is are searched for with the
 //      pose's own covariance as the gate (GuidedLightSearch), and kept with their identity. Their
 //      expected size is the dock's radius_m scaled by the median ratio of the identified lights'
@@ -68,6 +69,7 @@ struct MonoLightPipelineOptions {
   double weak_min_response = 12.0;
   double weak_halo_fraction = 0.3;
   double weak_min_support = 0.75;  // of the dock's lights that the weak pass's pose puts in view
+  bool weak_pass_after_failed_identification = true;  // false: only after < min_lights
   bool keep_unexplained = false;  // step 6 off
   double unexplained_gate_sigmas = 3.0;
   double unexplained_floor_px = 4.0;

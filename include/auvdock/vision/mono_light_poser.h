@@ -20,6 +20,7 @@
 // coordinates into the camera frame (OpenCV).
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <random>
 #include <string>
@@ -81,8 +82,11 @@ class MonoLightPoser {
   // as before the frame, and Retry may follow.
   MonoPoseResult ProcessTrackedOnly(const std::vector<LightDetection>& detections);
   // The same frame again with other detections (a second detection pass), when the frame gave no
-  // pose: the tracking state is that of the frame, not one frame older.
-  MonoPoseResult Retry(const std::vector<LightDetection>& detections);
+  // pose: the tracking state is that of the frame, not one frame older. A pose that `accept`
+  // (when given) refuses is no pose, and leaves the tracking state as it was (a weak pass's
+  // pose that explains too little of the dock must not be tracked from).
+  MonoPoseResult Retry(const std::vector<LightDetection>& detections,
+                       const std::function<bool(const MonoPoseResult&)>& accept = {});
 
   // The last pose, while tracking may use it for the next frame (use_tracking, at most
   // max_gap_frames old); otherwise nothing.
