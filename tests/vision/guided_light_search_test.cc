@@ -291,6 +291,15 @@ TEST(MonoLightPipeline, AFailedIdentificationGetsTheLaxerPassToo) {
   EXPECT_LT((frame.pose.T_C_D->p - T_C_D.p).norm(), 0.1);
 }
 
+// Detections of a view far from ViewFromAbove(4.0) (2 m higher, turned 1.2 rad about the axis):
+// a track from that view cannot label them.
+test::View ViewFarFromTheTrack(const DockModel& dock, const CameraCalibration& camera,
+                               std::mt19937_64* rng) {
+  Pose3 elsewhere = ViewFromAbove(6.0);
+  elsewhere.q = ExpQuaternion(Eigen::Vector3d(0.0, 0.0, 1.2)) * elsewhere.q;
+  return test::MakeView(dock, camera.intrinsics, elsewhere, test::AllLightIds(dock), 0, 0.2, *rng);
+}
+
 // A retry's pose that the caller refuses (the weak pass's: too little of the dock explained) is
 // no pose and is not tracked from: the tracking state stays that of the last accepted pose.
 TEST(MonoLightPoser, ARefusedRetryLeavesTheTrackAsItWas) {
@@ -302,10 +311,7 @@ TEST(MonoLightPoser, ARefusedRetryLeavesTheTrackAsItWas) {
   MonoLightPoser poser(camera, dock);
   ASSERT_TRUE(poser.Process(view.detections).T_C_D.has_value());
   const Pose3 tracked = *poser.TrackedPose();
-  Pose3 elsewhere = ViewFromAbove(6.0);
-  elsewhere.q = ExpQuaternion(Eigen::Vector3d(0.0, 0.0, 1.2)) * elsewhere.q;
-  const test::View other =
-      test::MakeView(dock, camera.intrinsics, elsewhere, test::AllLightIds(dock), 0, 0.2, rng);
+  const test::View other = ViewFarFromTheTrack(dock, camera, &rng);
   int asked = 0;
   const MonoPoseResult refused = poser.Retry(other.detections, [&](const MonoPoseResult& r) {
     ++asked;
@@ -342,11 +348,8 @@ TEST(MonoLightPoser, TrackedOnlyNeverIdentifiesFromScratchNorForgetsTheTrack) {
   MonoLightPoser poser(camera, dock);
   ASSERT_TRUE(poser.Process(view.detections).T_C_D.has_value());
   const Pose3 tracked = *poser.TrackedPose();
-  // A view far from the tracked one: tracking cannot label it, and nothing else may.
-  Pose3 elsewhere = ViewFromAbove(6.0);
-  elsewhere.q = ExpQuaternion(Eigen::Vector3d(0.0, 0.0, 1.2)) * elsewhere.q;
-  const test::View other =
-      test::MakeView(dock, camera.intrinsics, elsewhere, test::AllLightIds(dock), 0, 0.2, rng);
+  // Tracking cannot label the far view, and nothing else may.
+  const test::View other = ViewFarFromTheTrack(dock, camera, &rng);
   const MonoPoseResult result = poser.ProcessTrackedOnly(other.detections);
   EXPECT_FALSE(result.T_C_D.has_value());
   EXPECT_EQ(result.reason.rfind("tracking: ", 0), 0u) << result.reason;
