@@ -16,7 +16,11 @@ double ChiSquareCdf(int dof, double x) {
 }
 
 void AdaptiveNoiseScale::UpdateCensored(double statistic, int dof, double cutoff) {
-  if (!options_.enabled || dof < 1 || !(cutoff > 0.0) || !(statistic >= 0.0)) return;
+  if (!options_.enabled || dof < 1 || !(statistic >= 0.0)) return;
+  if (!(cutoff > 0.0)) {  // no cutoff (a sensor without a gate): every statistic counts
+    Update(statistic, static_cast<double>(dof));
+    return;
+  }
   if (statistic > cutoff) {
     ++censored_;
     return;

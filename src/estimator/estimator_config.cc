@@ -49,6 +49,8 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.adaptive_depth_noise.enabled =
       est.GetBool("adaptive_depth_noise", e.adaptive_depth_noise.enabled);
   e.adaptive_sbl_noise.enabled = est.GetBool("adaptive_sbl_noise", e.adaptive_sbl_noise.enabled);
+  e.innovation_outlier_gates =
+      est.GetNonNegative("innovation_outlier_gates", e.innovation_outlier_gates);
   e.vision.stereo_covariance_at_prediction =
       est.GetBool("stereo_covariance_at_prediction", e.vision.stereo_covariance_at_prediction);
   const std::string weighting = est.GetString("stage_weighting", "information");

@@ -126,6 +126,9 @@ TEST(AdaptiveNoiseScale, CensoredUpdateCountsWhatItLeavesOut) {
   scale.UpdateCensored(-1.0, 1, 10.83);  // ignored: not a statistic
   EXPECT_EQ(scale.censored(), 1);
   EXPECT_EQ(scale.redundancy_seen(), 1.0);
+  scale.UpdateCensored(20.0, 1, 0.0);  // no cutoff (a sensor with its gate off): counted
+  EXPECT_EQ(scale.censored(), 1);
+  EXPECT_EQ(scale.redundancy_seen(), 2.0);
 }
 
 }  // namespace

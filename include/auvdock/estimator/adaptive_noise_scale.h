@@ -55,7 +55,8 @@ class AdaptiveNoiseScale {
   }
 
   // One statistic that is chi-square with `dof` degrees of freedom when the factor in use is
-  // right (whitened by it), left out when above `cutoff` (> 0), see above.
+  // right (whitened by it), left out when above `cutoff`, see above; cutoff <= 0: none, every
+  // statistic counts as it is.
   void UpdateCensored(double statistic, int dof, double cutoff);
 
   double factor() const { return factor_; }
