@@ -284,9 +284,10 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
                             (range.t_ns == last_t_ns && range.transducer > last_transducer);
       std::optional<ceres::ResidualBlockId> id;
       BatchState* s = in_order ? state_at_or_before(range.t_ns) : nullptr;
-      SblRange scaled = range;
-      scaled.sigma_m *= std::sqrt(sensors.sbl_variance_factor);
-      if (s) id = AddSblFactor(&problem, scaled, *calibration.sbl, dock, blocks_of(s), s->t_ns);
+      if (s) {
+        id = AddSblFactor(&problem, range, *calibration.sbl, dock, blocks_of(s), s->t_ns,
+                          sensors.sbl_variance_factor);
+      }
       if (id) {
         sbl_residuals.push_back({*id, range.t_ns});
         last_t_ns = range.t_ns;

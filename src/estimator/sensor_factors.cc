@@ -87,7 +87,7 @@ std::optional<ceres::ResidualBlockId> AddSblFactor(ceres::Problem* problem,
                                                    const SblCalibration& calibration,
                                                    const DockModel& dock,
                                                    const StateBlocks& state, int64_t t_state_ns,
-                                                   double huber_sigmas) {
+                                                   double variance_factor, double huber_sigmas) {
   if (range.transducer < 0 ||
       range.transducer >= static_cast<int>(calibration.p_B_transducers.size()) ||
       !std::isfinite(range.range_m) || range.range_m < 0.0 || !std::isfinite(range.sigma_m) ||
@@ -99,7 +99,7 @@ std::optional<ceres::ResidualBlockId> AddSblFactor(ceres::Problem* problem,
   if (!shift) return std::nullopt;
   return AddOnState<SblRangeFactor, kSblRangeResidualSize>(
       problem,
-      std::make_unique<SblRangeFactor>(range.range_m, range.sigma_m,
+      std::make_unique<SblRangeFactor>(range.range_m, range.sigma_m * std::sqrt(variance_factor),
                                        calibration.p_B_transducers[range.transducer],
                                        dock.p_D_beacon),
       *shift, HuberOrNone(huber_sigmas), state);

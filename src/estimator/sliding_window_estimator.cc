@@ -352,12 +352,9 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachSbl(int64_t t_ns) {
   if (!calibration_.sbl) return {};
   return AttachPending(&pending_sbl_, t_ns, calibration_.sbl->name, &stats_.sbl_skipped,
                        [&](const SblRange& range, State& state) {
-                         SblRange scaled = range;
-                         scaled.sigma_m *= std::sqrt(sbl_noise_.factor());
-                         const std::optional<ceres::ResidualBlockId> id =
-                             AddSblFactor(problem_.get(), scaled, *calibration_.sbl, dock_,
-                                          BlocksOf(state), state.t_ns,
-                                          options_.sensor_huber_sigmas);
+                         const std::optional<ceres::ResidualBlockId> id = AddSblFactor(
+                             problem_.get(), range, *calibration_.sbl, dock_, BlocksOf(state),
+                             state.t_ns, sbl_noise_.factor(), options_.sensor_huber_sigmas);
                          if (id) sbl_transducer_of_[*id] = range.transducer;
                          return id;
                        });

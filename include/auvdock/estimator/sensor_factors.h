@@ -74,12 +74,14 @@ std::optional<ceres::ResidualBlockId> AddUsblFactor(ceres::Problem* problem,
                                                     double huber_sigmas = kNoRobustLoss);
 
 // The same for one SBL range (the beacon at dock.p_D_beacon); nothing also when its transducer
-// is not in the calibration or its sigma is not positive and finite.
+// is not in the calibration or its sigma is not positive and finite. variance_factor multiplies
+// the range's own variance (the adaptive estimate of the array's effective noise).
 std::optional<ceres::ResidualBlockId> AddSblFactor(ceres::Problem* problem,
                                                    const SblRange& range,
                                                    const SblCalibration& calibration,
                                                    const DockModel& dock,
                                                    const StateBlocks& state, int64_t t_state_ns,
+                                                   double variance_factor = 1.0,
                                                    double huber_sigmas = kNoRobustLoss);
 
 // Why a sample cannot be a measurement whatever the state (empty when it can): a depth above
