@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "auvdock/estimator/rejection.h"
+
 namespace auvdock {
 
 DvlRateVerdict DvlRateTest::Check(const DvlMeasurement& sample, const ImuBuffer& imu,
@@ -15,23 +17,31 @@ DvlRateVerdict DvlRateTest::Check(const DvlMeasurement& sample, const ImuBuffer&
   }
   const std::optional<Eigen::Vector3d> gyro = imu.GyroAt(sample.t_ns);
   const Eigen::Vector3d w_B = gyro ? Eigen::Vector3d(*gyro - bias.gyro) : Eigen::Vector3d::Zero();
-  const auto become_reference = [&](bool confirmed) {
-    reference_ = Reference{sample, w_B, confirmed};
+  const auto hold = [&](const std::string& reason) {
+    verdict.held = true;
+    verdict.reason = reason;
+    reference_ = Reference{sample, w_B, /*confirmed=*/false, /*held=*/true};
   };
   candidate_.reset();
   if (reference_ &&
       1e-9 * static_cast<double>(sample.t_ns - reference_->sample.t_ns) >
           options_.max_reference_age_s) {
+    if (reference_->held) {
+      verdict.dropped = reference_->sample;
+      verdict.dropped_reason = kHeldDvlExpiredReason;
+    }
     reference_.reset();
   }
   const std::optional<ImuPreintegration> pim =
       reference_ ? imu.Preintegrate(reference_->sample.t_ns, sample.t_ns, bias) : std::nullopt;
   if (!reference_ || !pim || !gyro) {
+    if (reference_ && reference_->held) {
+      verdict.dropped = reference_->sample;
+      verdict.dropped_reason = kHeldDvlExpiredReason;
+    }
     verdict.statistic = std::numeric_limits<double>::quiet_NaN();
-    verdict.reason = "rate test: no reference sample within " +
-                     std::to_string(options_.max_reference_age_s) +
-                     " s (the first after a start or a gap)";
-    become_reference(false);
+    hold("rate test: no reference sample within " + std::to_string(options_.max_reference_age_s) +
+         " s (the first after a start or a gap): held for the next sample");
     return verdict;
   }
   const Eigen::Quaterniond q_B_S = calibration_.T_B_S.q.normalized();
@@ -46,17 +56,34 @@ DvlRateVerdict DvlRateTest::Check(const DvlMeasurement& sample, const ImuBuffer&
   verdict.statistic = (sample.v_S - predicted).squaredNorm() / variance;
   verdict.pass = verdict.statistic <= options_.gate_chi2;
   if (verdict.pass) {
-    candidate_ = Reference{sample, w_B, true};
+    if (reference_->held) {  // the held sample is confirmed by this one
+      verdict.released = reference_->sample;
+      reference_->held = false;
+    }
+    candidate_ = Reference{sample, w_B, true, false};
   } else if (!reference_->confirmed) {
     // Two samples that disagree, the older never tested itself: either may be the spike, so
-    // neither is trusted. The newer one is rejected and waits, as the reference, for a sample
-    // that agrees with it.
-    verdict.reason = "rate test: disagrees with the previous sample, itself untested";
-    become_reference(false);
+    // neither is trusted. The older one is rejected, the newer waits for a sample that agrees.
+    if (reference_->held) {
+      verdict.dropped = reference_->sample;
+      verdict.dropped_reason = "rate test: disagrees with the next sample, neither of them tested";
+    }
+    hold("rate test: disagrees with the previous sample, itself untested: held for the next");
   } else {
     verdict.reason = "rate test: jump against the IMU since the last good sample";
   }
   return verdict;
+}
+
+std::optional<DvlMeasurement> DvlRateTest::ExpireHeld(int64_t now_ns) {
+  if (!reference_ || !reference_->held ||
+      !(1e-9 * static_cast<double>(now_ns - reference_->sample.t_ns) >
+        options_.max_reference_age_s)) {
+    return std::nullopt;
+  }
+  const DvlMeasurement held = reference_->sample;
+  reference_.reset();
+  return held;
 }
 
 void DvlRateTest::Confirm(int64_t t_ns) {

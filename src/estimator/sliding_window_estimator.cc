@@ -117,6 +117,14 @@ void SlidingWindowEstimator::Reset(const std::string& reason) {
   }
   window_.clear();
   symmetry_unresolved_ = false;
+  if (calibration_.dvl) {
+    if (const std::optional<DvlMeasurement> held =
+            dvl_rate_test_.ExpireHeld(std::numeric_limits<int64_t>::max())) {
+      ++stats_.dvl_rate_rejected;
+      rejections_.push_back({held->t_ns, calibration_.dvl->name, kNoStatistic,
+                             "rate test: held, and the estimator was reset (" + reason + ")"});
+    }
+  }
   dvl_rate_test_.Reset();
   sbl_transducer_of_.clear();
   ceres::Problem::Options problem_options;
@@ -439,14 +447,38 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDepth(int64_t t_ns) {
 
 std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
   std::vector<SensorResidual> added;
+  const std::string& name = calibration_.dvl->name;
+  const auto reject = [&](int64_t sample_t_ns, double statistic, const std::string& reason) {
+    ++stats_.dvl_rate_rejected;
+    rejections_.push_back({sample_t_ns, name, statistic, reason});
+  };
+  // The sample's factor on the state at or before it; shift: the IMU's motion from that state
+  // (computed once per sample; nullptr: none needed or available).
+  const auto add = [&](const DvlMeasurement& sample, State* state,
+                       const ImuPoseShift* shift) {
+    std::optional<ceres::ResidualBlockId> id;
+    if (state) {
+      id = AddDvlFactor(problem_.get(), sample, *calibration_.dvl, dock_, BlocksOf(*state),
+                        state->t_ns, shift, dvl_noise_.factor(), options_.sensor_huber_sigmas);
+    }
+    if (id) {
+      added.push_back({*id, sample.t_ns});
+    } else {
+      ++stats_.dvl_skipped;
+      rejections_.push_back({sample.t_ns, name, kNoStatistic, kNoStateReason});
+    }
+  };
+  if (const std::optional<DvlMeasurement> expired = dvl_rate_test_.ExpireHeld(t_ns)) {
+    reject(expired->t_ns, kNoStatistic, kHeldDvlExpiredReason);
+  }
   while (!pending_dvl_.empty() && pending_dvl_.front().t_ns <= t_ns) {
     const DvlMeasurement sample = pending_dvl_.front();
     pending_dvl_.pop_front();
-    std::optional<ceres::ResidualBlockId> id;
-    if (State* state = StateFor(sample.t_ns)) {
+    State* state = StateFor(sample.t_ns);
+    std::optional<ImuPoseShift> shift;
+    if (state) {
       const StateBlocks blocks = BlocksOf(*state);
-      const std::optional<ImuPoseShift> shift =
-          ImuShiftFromState(blocks, state->t_ns, sample.t_ns - state->t_ns, dock_.gravity_D);
+      shift = ImuShiftFromState(blocks, state->t_ns, sample.t_ns - state->t_ns, dock_.gravity_D);
       if (shift) {
         dvl_rate_test_.SetNoiseFactor(dvl_noise_.factor());
         const DvlRateVerdict verdict =
@@ -458,24 +490,28 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
               options_.innovation_outlier_gates * options_.dvl_rate_test.gate_chi2);
           stats_.dvl_variance_factor = dvl_noise_.factor();
         }
+        if (verdict.dropped) {
+          reject(verdict.dropped->t_ns, verdict.statistic, verdict.dropped_reason);
+        }
+        if (verdict.released) {  // a held sample that this one agrees with, at its own time
+          State* earlier = StateFor(verdict.released->t_ns);
+          std::optional<ImuPoseShift> earlier_shift;
+          if (earlier) {
+            earlier_shift = ImuShiftFromState(BlocksOf(*earlier), earlier->t_ns,
+                                              verdict.released->t_ns - earlier->t_ns,
+                                              dock_.gravity_D);
+          }
+          add(*verdict.released, earlier, earlier_shift ? &*earlier_shift : nullptr);
+        }
+        if (verdict.held) continue;
         if (!verdict.pass) {
-          ++stats_.dvl_rate_rejected;
-          rejections_.push_back(
-              {sample.t_ns, calibration_.dvl->name, verdict.statistic, verdict.reason});
+          reject(sample.t_ns, verdict.statistic, verdict.reason);
           continue;
         }
       }
-      // The shift is the one the rate test used: the IMU is preintegrated once per sample.
-      id = AddDvlFactor(problem_.get(), sample, *calibration_.dvl, dock_, blocks, state->t_ns,
-                        shift ? &*shift : nullptr, dvl_noise_.factor(),
-                        options_.sensor_huber_sigmas);
     }
-    if (id) {
-      added.push_back({*id, sample.t_ns});
-    } else {
-      ++stats_.dvl_skipped;
-      rejections_.push_back({sample.t_ns, calibration_.dvl->name, kNoStatistic, kNoStateReason});
-    }
+    // The shift is the one the rate test used: the IMU is preintegrated once per sample.
+    add(sample, state, shift ? &*shift : nullptr);
   }
   return added;
 }

@@ -167,28 +167,20 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
   // 6. What the pose does not explain, far from every light it puts in the image, is not a light
   // of the dock.
   if (frame.pose.T_C_D && !options_.keep_unexplained) {
-    const std::vector<PredictedLight> predicted = PredictLights(
-        dock_, camera_.intrinsics, *frame.pose.T_C_D, frame.pose.covariance_local, {});
-    const auto near_a_light = [&](const LightDetection& d) {
-      return std::any_of(predicted.begin(), predicted.end(), [&](const PredictedLight& p) {
-        const double sigma = std::sqrt(std::max(0.0, p.covariance.eigenvalues().real().maxCoeff()));
-        const double radius = options_.unexplained_gate_sigmas * sigma +
-                              std::max({options_.unexplained_floor_px, p.radius_px,
-                                        options_.unexplained_gate_sigmas * frame.pose.rms_px});
-        return (d.uv - p.uv).norm() <= radius;
-      });
-    };
-    // A pose that identifies few of the lights it puts in view (a poor camera model fits some
-    // lights and misplaces the rest) is no judge of the others.
-    const bool judge = frame.pose.num_lights >=
-                       options_.unexplained_min_support * static_cast<double>(predicted.size());
+    PoseVerdictOptions verdict_options;
+    verdict_options.gate_sigmas = options_.unexplained_gate_sigmas;
+    verdict_options.floor_px = options_.unexplained_floor_px;
+    verdict_options.min_support = options_.unexplained_min_support;
+    const PoseVerdict verdict(dock_, camera_.intrinsics, *frame.pose.T_C_D,
+                              frame.pose.covariance_local, frame.pose.rms_px,
+                              frame.pose.num_lights, verdict_options);
     const std::vector<LightDetection> all = frame.detections;
-    if (judge)
-      KeepDetections(&frame, [&](int i, int id) {
-        if (id >= 0 || near_a_light(all[i])) return true;
-        frame.unexplained.push_back(all[i]);
-        return false;
-      });
+    const std::vector<bool> none = NoLightOfTheDock(all, frame.pose.light_ids, verdict);
+    KeepDetections(&frame, [&](int i, int) {
+      if (!none[i]) return true;
+      frame.unexplained.push_back(all[i]);
+      return false;
+    });
   }
   frame.detect_s = Seconds(t0, t1) + Seconds(t2, Clock::now()) - frame.identify_s;
   frame.identify_s += Seconds(t1, t2);

@@ -48,6 +48,7 @@ TEST_F(DvlRateTestTest, CleanSamplesPassAfterTheFirstAndSpikesFail) {
   DvlRateTest test(calibration_, DvlRateTestOptions());
   const DvlRateVerdict first = Check(&test, Sample(0));
   EXPECT_FALSE(first.pass);
+  EXPECT_TRUE(first.held);  // nothing to test it against yet: the next sample decides
   EXPECT_TRUE(std::isnan(first.statistic));
   int passed = 0;
   for (int k = 1; k < 50; ++k) {
@@ -60,6 +61,10 @@ TEST_F(DvlRateTestTest, CleanSamplesPassAfterTheFirstAndSpikesFail) {
     } else {
       passed += v.pass;
       if (v.pass) test.Confirm(Sample(k).t_ns);
+      if (k == 1) {  // agrees with the first, which is released to the estimator
+        ASSERT_TRUE(v.released.has_value());
+        EXPECT_EQ(v.released->t_ns, Sample(0).t_ns);
+      }
     }
   }
   EXPECT_GE(passed, 43);  // of 45 clean samples (p = 0.999 each)
@@ -79,17 +84,22 @@ TEST_F(DvlRateTestTest, ALongSmallBiasFailsWhileTheReferenceIsYoung) {
 }
 
 // A spike as the very first sample does not lock the test: the next clean sample disagrees
-// with it and is rejected in its place as the untested reference, the one after agrees with it
-// and passes, and once kept is the reference.
+// with it, so the held spike is rejected and the clean one held in its place; the one after
+// agrees with it, passes and releases it, and once kept is the reference.
 TEST_F(DvlRateTestTest, ASpikeFirstDoesNotLockTheTest) {
   DvlRateTest test(calibration_, DvlRateTestOptions());
-  EXPECT_FALSE(Check(&test, Sample(0, Eigen::Vector3d(0.5, 0.0, 0.0))).pass);
+  EXPECT_TRUE(Check(&test, Sample(0, Eigen::Vector3d(0.5, 0.0, 0.0))).held);
   const DvlRateVerdict second = Check(&test, Sample(1));
   EXPECT_FALSE(second.pass);
-  EXPECT_EQ(second.reason, "rate test: disagrees with the previous sample, itself untested");
+  EXPECT_TRUE(second.held);
+  ASSERT_TRUE(second.dropped.has_value());
+  EXPECT_EQ(second.dropped->t_ns, Sample(0).t_ns);
+  EXPECT_FALSE(second.released.has_value());
   for (int k = 2; k < 10; ++k) {
     const DvlMeasurement m = Sample(k);
-    EXPECT_TRUE(Check(&test, m).pass) << k;
+    const DvlRateVerdict v = Check(&test, m);
+    EXPECT_TRUE(v.pass) << k;
+    EXPECT_EQ(v.released.has_value(), k == 2) << k;
     test.Confirm(m.t_ns);
   }
   EXPECT_FALSE(Check(&test, Sample(10, Eigen::Vector3d(0.0, 0.0, 0.3))).pass);
@@ -102,13 +112,20 @@ TEST_F(DvlRateTestTest, ASpikeSecondIsNotLetThrough) {
   DvlRateTest test(calibration_, DvlRateTestOptions());
   EXPECT_FALSE(Check(&test, Sample(0)).pass);
   const DvlMeasurement spike = Sample(1, Eigen::Vector3d(-0.17, 0.28, -0.17));
-  EXPECT_FALSE(Check(&test, spike).pass);
-  test.Confirm(spike.t_ns);  // a gate's word cannot make it the reference: it was rejected
-  EXPECT_FALSE(Check(&test, Sample(2)).pass);  // disagrees with the untested spike
+  const DvlRateVerdict at_spike = Check(&test, spike);
+  EXPECT_FALSE(at_spike.pass);
+  EXPECT_TRUE(at_spike.dropped.has_value());  // the first: of two that disagree, either may be bad
+  test.Confirm(spike.t_ns);  // a gate's word cannot make it the reference: it was not passed
+  const DvlRateVerdict after = Check(&test, Sample(2));
+  EXPECT_FALSE(after.pass);  // disagrees with the untested spike
+  ASSERT_TRUE(after.dropped.has_value());
+  EXPECT_EQ(after.dropped->t_ns, spike.t_ns);
   int passed = 0;
   for (int k = 3; k < 20; ++k) {
     const DvlMeasurement m = Sample(k);
-    if (Check(&test, m).pass) {
+    const DvlRateVerdict v = Check(&test, m);
+    if (v.released) EXPECT_NE(v.released->t_ns, spike.t_ns);
+    if (v.pass) {
       ++passed;
       test.Confirm(m.t_ns);
     }
@@ -133,6 +150,34 @@ TEST_F(DvlRateTestTest, OnlyConfirmedCandidatesBecomeTheReferenceAndOldOnesExpir
   EXPECT_FALSE(expired.pass);
   EXPECT_TRUE(std::isnan(expired.statistic));
   EXPECT_TRUE(Check(&test, Sample(8, changed)).pass);  // the changed sensor, consistent again
+}
+
+// The first clean sample after a fault that outlasted the reference is held, not rejected, and
+// released by the next; a held sample that nothing comes to test expires.
+TEST_F(DvlRateTestTest, TheFirstCleanSampleAfterALongFaultIsHeldNotRejected) {
+  DvlRateTestOptions options;
+  options.max_reference_age_s = 1.0;
+  DvlRateTest test(calibration_, options);
+  for (int k = 0; k < 5; ++k) {
+    if (Check(&test, Sample(k)).pass) test.Confirm(Sample(k).t_ns);
+  }
+  const Eigen::Vector3d bias(0.3, 0.0, 0.0);
+  for (int k = 5; k < 12; ++k) Check(&test, Sample(k, bias));  // the gate keeps none of them
+  const DvlRateVerdict clean = Check(&test, Sample(12));
+  EXPECT_FALSE(clean.pass);
+  EXPECT_TRUE(clean.held) << clean.reason;
+  const DvlRateVerdict next = Check(&test, Sample(13));
+  EXPECT_TRUE(next.pass);
+  ASSERT_TRUE(next.released.has_value());
+  EXPECT_EQ(next.released->t_ns, Sample(12).t_ns);
+
+  DvlRateTest lone(calibration_, options);
+  ASSERT_TRUE(Check(&lone, Sample(0)).held);
+  EXPECT_FALSE(lone.ExpireHeld(Sample(5).t_ns).has_value());  // 1.0 s: not yet
+  const std::optional<DvlMeasurement> expired = lone.ExpireHeld(Sample(6).t_ns);
+  ASSERT_TRUE(expired.has_value());
+  EXPECT_EQ(expired->t_ns, Sample(0).t_ns);
+  EXPECT_FALSE(lone.ExpireHeld(Sample(20).t_ns).has_value());
 }
 
 }  // namespace

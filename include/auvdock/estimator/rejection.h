@@ -23,6 +23,9 @@ inline constexpr double kNoStatistic = std::numeric_limits<double>::quiet_NaN();
 inline constexpr const char* kNoStateReason =
     "no state at or before its time or the IMU does not reach it";
 // ... of one from before the sliding window's first state since its last initialisation.
+// ... of a DVL sample the rate test held (dvl_rate_test.h) that no later sample came to test.
+inline constexpr const char* kHeldDvlExpiredReason =
+    "rate test: held, and no sample within the reference age came to test it against";
 inline constexpr const char* kBeforeFirstStateReason =
     "before the estimator's first state (it initialised after this sample)";
 

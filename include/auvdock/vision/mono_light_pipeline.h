@@ -25,17 +25,13 @@
 //      pose's own covariance as the gate (GuidedLightSearch), and kept with their identity. Their
 //      expected size is the dock's radius_m scaled by the median ratio of the identified lights'
 //      radii to their predicted ones (the glow, not the dock file, sets a light's blob size).
-//   6. With a pose, the detections it leaves unidentified and that lie farther from every light
-//      it puts in the image than g sigma + max(unexplained_floor_px, the light's expected radius,
-//      g rms) (g = unexplained_gate_sigmas; sigma: the largest of the prediction's pixel
-//      covariance; rms: the pose fit's residual, which a poor camera model makes large) are
-//      not the dock's lights by the dock model's verdict (reflections, lit fittings, clutter that
-//      passed the checks): they move to MonoLightFrame::unexplained unless keep_unexplained. A
+//   6. With a pose, the detections it leaves unidentified far from every light it puts in the
+//      image are not the dock's lights by the dock model's verdict (pose_verdict.h: reflections,
+//      lit fittings, clutter that passed the checks; unexplained_gate_sigmas, _floor_px,
+//      _min_support): they move to MonoLightFrame::unexplained unless keep_unexplained. A
 //      detection near a predicted light stays, unidentified: it may be that light, left out by
-//      the matcher's gate, or part of its glow. Only a pose that identifies at least
-//      unexplained_min_support of the lights it puts in the image judges: with a poor camera
-//      model a pose fits a few lights and misplaces the others (on the pool clip's second model,
-//      4 of 7 LEDs). Without a pose nothing is verified, and every detection stays.
+//      the matcher's gate, or part of its glow. Without a pose nothing is verified, and every
+//      detection stays.
 // The colour learner sees the first pass's identified lights only (the others passed a laxer
 // test). Guided and weak detections are ordinary detections in the output, with their own
 // centroid covariance; MonoLightFrame counts them.
@@ -53,6 +49,7 @@
 #include "auvdock/vision/guided_light_search.h"
 #include "auvdock/vision/halo_colour_learner.h"
 #include "auvdock/vision/mono_light_poser.h"
+#include "auvdock/vision/pose_verdict.h"
 
 namespace auvdock {
 
