@@ -76,14 +76,17 @@ MatchResult Ambiguous(const std::string& reason) {
 // detections not excluded, cost = pixel distance. Returns false with a reason when a second choice
 // is within margin_px of a chosen pair (two lights for one detection, or two detections for one
 // light).
+// gate_scale (optional, per detection): the light's gate is widened by it for that detection.
 bool AssignGated(const std::vector<LightDetection>& detections,
                  const std::vector<ProjectedLight>& lights, const std::vector<char>& excluded,
-                 double margin_px, std::vector<int>* detection_of_light, std::string* reason) {
+                 double margin_px, std::vector<int>* detection_of_light, std::string* reason,
+                 const std::vector<double>* gate_scale = nullptr) {
   Eigen::MatrixXd cost(lights.size(), detections.size());
   for (size_t i = 0; i < lights.size(); ++i) {
     for (size_t j = 0; j < detections.size(); ++j) {
       const double d = (detections[j].uv - lights[i].uv).norm();
-      cost(i, j) = d <= lights[i].gate_px && !excluded[j] ? d : kForbiddenCost;
+      const double gate = lights[i].gate_px * (gate_scale ? (*gate_scale)[j] : 1.0);
+      cost(i, j) = d <= gate && !excluded[j] ? d : kForbiddenCost;
     }
   }
   *detection_of_light = SolveAssignment(cost);
@@ -136,7 +139,8 @@ bool PoseFitConsistentWithNoise(double squared_error_px2, int num_matches, doubl
 
 double RefinePoseOnCorrespondences(const std::vector<Eigen::Vector3d>& points_D,
                                    const std::vector<Eigen::Vector2d>& normalized_xy, double fx,
-                                   double fy, Pose3* T_C_D) {
+                                   double fy, Pose3* T_C_D, const std::vector<double>& weights) {
+  const auto weight = [&](size_t i) { return weights.empty() ? 1.0 : weights[i]; };
   Eigen::Matrix3d R = T_C_D->R();
   Eigen::Vector3d t = T_C_D->p;
   auto cost_of = [&](const Eigen::Matrix3d& R_c, const Eigen::Vector3d& t_c) {
@@ -146,7 +150,7 @@ double RefinePoseOnCorrespondences(const std::vector<Eigen::Vector3d>& points_D,
       if (!(p.z() > 1e-9)) return std::numeric_limits<double>::infinity();
       const double du = fx * (p.x() / p.z() - normalized_xy[i].x());
       const double dv = fy * (p.y() / p.z() - normalized_xy[i].y());
-      cost += du * du + dv * dv;
+      cost += weight(i) * (du * du + dv * dv);
     }
     return cost;
   };
@@ -168,8 +172,8 @@ double RefinePoseOnCorrespondences(const std::vector<Eigen::Vector3d>& points_D,
       J.rightCols<3>() = J_proj;
       const Eigen::Vector2d r(fx * (p.x() * iz - normalized_xy[i].x()),
                               fy * (p.y() * iz - normalized_xy[i].y()));
-      H.noalias() += J.transpose() * J;
-      g.noalias() += J.transpose() * r;
+      H.noalias() += weight(i) * J.transpose() * J;
+      g.noalias() += weight(i) * J.transpose() * r;
     }
     if (lambda < 0.0) lambda = 1e-4 * H.diagonal().mean();
     bool improved = false;
@@ -231,6 +235,18 @@ MatchResult MatchByPrediction(const std::vector<LightDetection>& detections, con
     }
     lights[i].gate_px =
         std::clamp(options.spacing_fraction * nearest, options.min_residual_gate_px, max_gate);
+  }
+
+  // Each detection's noise relative to pixel_noise_px (its own covariance, never below it), and
+  // its final gate relative to final_gate_px (3 of its own sigmas, never below that gate).
+  std::vector<double> scale(detections.size(), 1.0), gate_scale(detections.size(), 1.0);
+  if (options.use_detection_covariance) {
+    for (size_t j = 0; j < detections.size(); ++j) {
+      const double own = std::sqrt(std::max(0.0, detections[j].covariance.trace() / 2.0));
+      if (!std::isfinite(own)) continue;
+      scale[j] = std::max(1.0, own / options.pixel_noise_px);
+      gate_scale[j] = std::max(1.0, 3.0 * own / options.final_gate_px);
+    }
   }
 
   // 1. The common image offset with the most support.
@@ -303,23 +319,28 @@ MatchResult MatchByPrediction(const std::vector<LightDetection>& detections, con
                    bool* within_gate) {
       std::vector<Eigen::Vector3d> points_D;
       std::vector<Eigen::Vector2d> points_xy;
+      std::vector<double> weights;
       for (size_t i = 0; i < lights.size(); ++i) {
         if (assignment[i] < 0 || static_cast<int>(i) == skip) continue;
         points_D.push_back(dock.lights[lights[i].index].p_D);
         points_xy.push_back(normalized[assignment[i]]);
+        const double k = scale[assignment[i]];
+        weights.push_back(1.0 / (k * k));
       }
       *count = static_cast<int>(points_D.size());
       if (*count < 3) return std::numeric_limits<double>::infinity();
-      RefinePoseOnCorrespondences(points_D, points_xy, camera.fx(), camera.fy(), T_C_D);
+      RefinePoseOnCorrespondences(points_D, points_xy, camera.fx(), camera.fy(), T_C_D, weights);
       double squared_error = 0.0;
       *within_gate = true;
       for (size_t i = 0; i < lights.size(); ++i) {
         if (assignment[i] < 0 || static_cast<int>(i) == skip) continue;
         const auto uv = camera.Project(*T_C_D * dock.lights[lights[i].index].p_D);
+        const double k = scale[assignment[i]];
+        const double gate = options.final_gate_px * gate_scale[assignment[i]];
         const double r2 = uv ? (*uv - detections[assignment[i]].uv).squaredNorm()
                              : std::numeric_limits<double>::infinity();
-        squared_error += r2;
-        *within_gate = *within_gate && r2 <= options.final_gate_px * options.final_gate_px;
+        squared_error += r2 / (k * k);
+        *within_gate = *within_gate && r2 <= gate * gate;
       }
       return squared_error;
     };
@@ -375,7 +396,7 @@ MatchResult MatchByPrediction(const std::vector<LightDetection>& detections, con
       }
       std::vector<int> reassigned;
       if (!AssignGated(detections, refined, excluded, options.ambiguity_margin_px, &reassigned,
-                       &reason)) {
+                       &reason, &gate_scale)) {
         return Ambiguous("at the refined pose: " + reason);
       }
       const bool unchanged = reassigned == detection_of_light;
@@ -391,7 +412,7 @@ MatchResult MatchByPrediction(const std::vector<LightDetection>& detections, con
     const int j = detection_of_light[i];
     if (j < 0) continue;
     result.matches.push_back({j, final_lights[i].light_id});
-    squared_sum += (detections[j].uv - final_lights[i].uv).squaredNorm();
+    squared_sum += (detections[j].uv - final_lights[i].uv).squaredNorm() / (scale[j] * scale[j]);
   }
   if (Count(detection_of_light) < options.min_matches) {
     return Failed("only " + std::to_string(result.matches.size()) + " matches");

@@ -195,3 +195,67 @@ TEST(MatchByPrediction, TooFewMatchesFail) {
 
 }  // namespace
 }  // namespace auvdock
+
+namespace auvdock {
+namespace {
+
+// Four lights, one of them cut by the border: its centroid is biased by 6 px and says so in its
+// covariance (sigma 6 px). Weighed by that covariance the four are one pose; with one noise for
+// all they are not, and the frame has no labels (the real pool clip's frames 385-405).
+TEST(MatchByPrediction, ADetectionWithAWideCovarianceWeighsLess) {
+  const DockModel dock = LoadDock("t_shape.yaml");
+  const PinholeRadtanCamera camera = DefaultMonoCamera();
+  std::mt19937_64 rng(77);
+  const Pose3 T_C_D = RandomView(dock, camera, 20.0 * kDeg, rng);
+  std::normal_distribution<double> noise(0.0, 0.3);
+  std::vector<LightDetection> detections;
+  for (int index : {0, 2, 3, 5}) {
+    LightDetection d;
+    d.uv = *camera.Project(T_C_D * dock.lights[index].p_D) +
+           Eigen::Vector2d(noise(rng), noise(rng));
+    d.covariance = 0.09 * Eigen::Matrix2d::Identity();
+    if (index == 5) {
+      d.uv += Eigen::Vector2d(0.0, -6.0);
+      d.covariance = 36.0 * Eigen::Matrix2d::Identity();
+    }
+    detections.push_back(d);
+  }
+  TrackingMatcherOptions options;
+  options.gate_px = 20.0;
+  options.min_matches = 4;
+  const MatchResult weighed = MatchByPrediction(detections, dock, camera, T_C_D, options);
+  ASSERT_EQ(weighed.status, MatchStatus::kOk) << weighed.reason;
+  ASSERT_EQ(weighed.matches.size(), 4u);
+  const std::vector<int> index_of_detection = {0, 2, 3, 5};
+  for (const LightMatch& m : weighed.matches) {
+    EXPECT_EQ(m.light_id, dock.lights[index_of_detection[m.detection]].id);
+  }
+  options.use_detection_covariance = false;
+  const MatchResult one_noise = MatchByPrediction(detections, dock, camera, T_C_D, options);
+  EXPECT_NE(one_noise.status, MatchStatus::kOk);
+}
+
+// The weights pull the refined pose towards the precise correspondences.
+TEST(RefinePoseOnCorrespondences, WeightsFollowThePreciseCorrespondences) {
+  const DockModel dock = LoadDock("t_shape.yaml");
+  const PinholeRadtanCamera camera = DefaultMonoCamera();
+  std::mt19937_64 rng(78);
+  const Pose3 truth = RandomView(dock, camera, 20.0 * kDeg, rng);
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector2d> xy;
+  for (const DockLight& light : dock.lights) {
+    points.push_back(light.p_D);
+    xy.push_back(camera.Unproject(*camera.Project(truth * light.p_D)));
+  }
+  xy[4] += Eigen::Vector2d(0.01, 0.0);  // ~5 px off
+  std::vector<double> weights(points.size(), 1.0);
+  weights[4] = 1e-6;
+  Pose3 even = truth, weighed = truth;
+  RefinePoseOnCorrespondences(points, xy, camera.fx(), camera.fy(), &even);
+  RefinePoseOnCorrespondences(points, xy, camera.fx(), camera.fy(), &weighed, weights);
+  EXPECT_GT((even.p - truth.p).norm(), 1e-3);
+  EXPECT_LT((weighed.p - truth.p).norm(), 1e-5);
+}
+
+}  // namespace
+}  // namespace auvdock

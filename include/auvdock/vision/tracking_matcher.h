@@ -15,7 +15,8 @@
 //      support;
 //   2. assigns by gated Hungarian (SolveAssignment): cost |d_j - (p_L + o)| in pixels,
 //      forbidden beyond r_L;
-//   3. (refine_pose) refines T_C_D on those matches (RefinePoseOnCorrespondences); while the
+//   3. (refine_pose) refines T_C_D on those matches (RefinePoseOnCorrespondences; each match
+//      weighted by its detection's own covariance, use_detection_covariance); while the
 //      fit is worse than pixel_noise_px explains (PoseFitConsistentWithNoise) or leaves a match
 //      more than final_gate_px away, excludes the match whose removal leaves the most
 //      consistent fit (never below 4: a minimal set cannot be checked -> kFailed), and
@@ -69,6 +70,11 @@ struct TrackingMatcherOptions {
   double acceptance_alpha = 1e-8;    // step 3: a final fit less likely than this -> kFailed
   int min_matches = 3;
   double min_depth_m = 0.05;  // lights closer to the camera plane than this are not projected
+  // Step 3 with each detection's own centroid covariance: a detection whose claimed sigma
+  // s_j = sqrt(trace(C_j) / 2) exceeds pixel_noise_px (a light cut by the border, a large
+  // saturated core) weighs (pixel_noise_px / s_j)^2 in the refinement and the consistency
+  // test, and its final gate is max(final_gate_px, 3 s_j). false: one noise for all.
+  bool use_detection_covariance = true;
 };
 
 // MatchResult::cost is the RMS residual (px) of the matches after removing the common offset.
@@ -86,11 +92,12 @@ MatchResult MatchByPrediction(const std::vector<LightDetection>& detections, con
 //   sum_i |(fx (X_i/Z_i - x_i), fy (Y_i/Z_i - y_i))|^2,  (X, Y, Z) = R_C_D p_D_i + p_C_D,
 // the reprojection error in pixel-equivalent units (the local scale change of the distortion, a
 // few percent, is ignored). Rotation perturbed on the left, R <- Exp(dtheta) R. Needs >= 3
-// correspondences; converges to the local minimum near the start. Returns the final squared
-// error (px^2).
+// correspondences; converges to the local minimum near the start. weights (empty: all 1)
+// multiply each correspondence's squared error. Returns the final weighted squared error (px^2).
 double RefinePoseOnCorrespondences(const std::vector<Eigen::Vector3d>& points_D,
                                    const std::vector<Eigen::Vector2d>& normalized_xy, double fx,
-                                   double fy, Pose3* T_C_D);
+                                   double fy, Pose3* T_C_D,
+                                   const std::vector<double>& weights = {});
 
 // True when a pose fit on num_matches correspondences is consistent with isotropic Gaussian
 // pixel noise of sigma_px per axis: P(chi-square with 2 n - 6 degrees of freedom >
