@@ -122,35 +122,14 @@ MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detectio
     result.reason = std::string(MatchStatusName(match.status)) + ": " + match.reason;
     return result;
   }
-  std::string reason;
-  const std::optional<LabelledPose> pose =
-      PoseFromMatches(detections, match.matches, start, sigma, &reason);
-  if (!pose) {
-    result.status = MatchStatus::kFailed;
-    result.reason = "pnp: " + reason;
-    return result;
-  }
-  result.light_ids = pose->light_ids;
-  result.T_C_D = pose->T_C_D;
-  result.rms_px = pose->rms_px;
-  result.num_lights = pose->num_lights;
-  result.covariance_local = pose->covariance_local;
-  last_T_C_D_ = pose->T_C_D;
-  frames_since_pose_ = 0;
-  return result;
-}
 
-std::optional<LabelledPose> MonoLightPoser::PoseFromMatches(
-    const std::vector<LightDetection>& detections, const std::vector<LightMatch>& matches,
-    const std::optional<Pose3>& start, double sigma, std::string* reason) const {
-  LabelledPose out;
-  out.light_ids.assign(detections.size(), -1);
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector2d> pixels;
-  for (const LightMatch& m : matches) {
+  std::vector<int> ids(detections.size(), -1);
+  for (const LightMatch& m : match.matches) {
     const DockLight* light = dock_.FindLight(m.light_id);
     if (!light || m.detection < 0 || m.detection >= static_cast<int>(detections.size())) continue;
-    out.light_ids[m.detection] = m.light_id;
+    ids[m.detection] = m.light_id;
     points.push_back(light->p_D);
     pixels.push_back(detections[m.detection].uv);
   }
@@ -158,19 +137,23 @@ std::optional<LabelledPose> MonoLightPoser::PoseFromMatches(
   pnp.pixel_sigma = sigma;
   const PnpResult pose = SolvePnp(points, pixels, camera_.intrinsics, pnp, start);
   if (!pose.ok) {
-    *reason = pose.reason;
-    return std::nullopt;
+    result.status = MatchStatus::kFailed;
+    result.reason = "pnp: " + pose.reason;
+    return result;
   }
-  out.T_C_D = pose.T_C_D;
-  out.rms_px = pose.rms_px;
-  out.num_lights = static_cast<int>(points.size());
-  out.covariance_local = pose.covariance_local;
-  const int dof = 2 * out.num_lights - 6;
+  result.light_ids = ids;
+  result.T_C_D = pose.T_C_D;
+  result.rms_px = pose.rms_px;
+  result.num_lights = static_cast<int>(points.size());
+  result.covariance_local = pose.covariance_local;
+  const int dof = 2 * result.num_lights - 6;
   if (dof > 0) {
-    const double s02 = pose.rms_px * pose.rms_px * out.num_lights / (sigma * sigma * dof);
-    if (s02 > 1.0) out.covariance_local *= s02;
+    const double s02 = pose.rms_px * pose.rms_px * result.num_lights / (sigma * sigma * dof);
+    if (s02 > 1.0) result.covariance_local *= s02;
   }
-  return out;
+  last_T_C_D_ = pose.T_C_D;
+  frames_since_pose_ = 0;
+  return result;
 }
 
 }  // namespace auvdock

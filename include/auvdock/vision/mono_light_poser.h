@@ -56,16 +56,6 @@ struct MonoLightPoserOptions {
   uint64_t seed = 1;
 };
 
-// A pose from identified lights: PnP on them, its covariance inflated by the a-posteriori
-// variance factor when the fit is worse than the noise explains.
-struct LabelledPose {
-  std::vector<int> light_ids;  // per detection: dock light id or -1
-  Pose3 T_C_D;
-  Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
-  double rms_px = 0.0;
-  int num_lights = 0;
-};
-
 struct MonoPoseResult {
   std::vector<int> light_ids;  // per detection: dock light id or -1
   MatchStatus status = MatchStatus::kFailed;
@@ -107,11 +97,6 @@ class MonoLightPoser {
   DockModel dock_;
   MonoLightPoserOptions options_;
   MonoPoseResult Solve(const std::vector<LightDetection>& detections, bool from_scratch);
-  // nullopt (and *reason) when PnP fails.
-  std::optional<LabelledPose> PoseFromMatches(const std::vector<LightDetection>& detections,
-                                              const std::vector<LightMatch>& matches,
-                                              const std::optional<Pose3>& start, double sigma,
-                                              std::string* reason) const;
 
   std::mt19937_64 rng_;
   std::optional<Pose3> last_T_C_D_;
