@@ -42,6 +42,12 @@ RunConfig LoadRunConfig(const std::string& path) {
       est.GetPositive("dvl_rate_accel_sigma_mps2", e.dvl_rate_test.accel_sigma_mps2);
   e.dvl_rate_test.max_reference_age_s =
       est.GetPositive("dvl_rate_max_reference_age_s", e.dvl_rate_test.max_reference_age_s);
+  e.acoustic_init.enabled = est.GetBool("acoustic_init", e.acoustic_init.enabled);
+  e.acoustic_init.min_fixes = est.GetInt("acoustic_init_min_fixes", e.acoustic_init.min_fixes);
+  if (e.acoustic_init.min_fixes < 3) est.Fail("acoustic_init_min_fixes", "must be at least 3");
+  e.acoustic_init.max_span_s = est.GetPositive("acoustic_init_max_span_s", e.acoustic_init.max_span_s);
+  e.acoustic_init.max_heading_sigma_rad = est.GetPositive(
+      "acoustic_init_max_heading_sigma_rad", e.acoustic_init.max_heading_sigma_rad);
   e.vision.use_stereo = est.GetBool("use_stereo", e.vision.use_stereo);
   e.adaptive_vision_noise.enabled =
       est.GetBool("adaptive_vision_noise", e.adaptive_vision_noise.enabled);

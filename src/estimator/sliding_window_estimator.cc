@@ -69,7 +69,8 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
       dvl_noise_(options.adaptive_dvl_noise),
       depth_noise_(options.adaptive_depth_noise),
       sbl_noise_(options.adaptive_sbl_noise),
-      usbl_rate_test_(options.usbl_rate_test) {
+      usbl_rate_test_(options.usbl_rate_test),
+      acoustic_init_(calibration, dock.gravity_D, options.acoustic_init) {
   // An outlier's sample is kept out of the noise statistics (second_difference.h).
   SecondDifferenceOptions depth_innovation = options.depth_innovation;
   depth_innovation.outlier_cutoff = options.innovation_outlier_gates * options.depth_gate_chi2;
@@ -156,8 +157,12 @@ void SlidingWindowEstimator::AddImu(const ImuSample& sample) {
       window_.empty() ? 0
                       : window_.front()->t_ns -
                             static_cast<int64_t>(options_.usbl_max_backward_shift_s * kNsPerSecond);
-  imu_.DropBefore(window_.empty() ? sample.t_ns - static_cast<int64_t>(kNsPerSecond)
-                                  : std::min({window_.front()->t_ns, rate_test_ns, late_fix_ns}));
+  // Before initialisation the acoustic start traces the path over its span.
+  const double history_s =
+      options_.acoustic_init.enabled ? std::max(1.0, acoustic_init_.imu_history_s()) : 1.0;
+  imu_.DropBefore(window_.empty()
+                      ? sample.t_ns - static_cast<int64_t>(history_s * kNsPerSecond)
+                      : std::min({window_.front()->t_ns, rate_test_ns, late_fix_ns}));
 }
 
 std::string SlidingWindowEstimator::TiltRefusal(const VisionFrame& frame) const {
@@ -190,26 +195,60 @@ bool SlidingWindowEstimator::Initialize(const VisionFrame& frame) {
   }
   init_refusal_.clear();
   symmetry_unresolved_ = frame.symmetry_unresolved;
+  InitialState initial;
+  initial.t_ns = frame.t_ns;
+  initial.T_D_B = *frame.T_D_B_initial;
+  initial.pose_covariance.setZero();
+  initial.pose_covariance.topLeftCorner<3, 3>().diagonal().setConstant(
+      std::pow(options_.init_position_sigma_m, 2));
+  initial.pose_covariance.bottomRightCorner<3, 3>().diagonal().setConstant(
+      std::pow(options_.init_attitude_sigma_rad, 2));
+  initial.velocity_covariance =
+      Eigen::Matrix3d::Identity() * std::pow(options_.init_velocity_sigma_mps, 2);
+  StartWindow(initial);
+  return true;
+}
+
+bool SlidingWindowEstimator::InitializeAcoustically(int64_t t_ns) {
+  if (!options_.acoustic_init.enabled || !acoustic_init_.has_new_data()) return false;
+  std::string why;
+  const std::optional<InitialState> initial = acoustic_init_.Solve(imu_, t_ns, &why);
+  if (!initial) {
+    init_refusal_ = why;
+    return false;
+  }
+  init_refusal_.clear();
+  symmetry_unresolved_ = false;
+  ++stats_.acoustic_starts;
+  char text[200];
+  std::snprintf(text, sizeof(text),
+                "acoustic start at %lld ns: %d fixes (%d left out), heading to %.1f deg",
+                static_cast<long long>(t_ns), initial->fixes_used, initial->fixes_rejected,
+                initial->heading_sigma_rad * 180.0 / M_PI);
+  stats_.log.push_back(text);
+  // The fixes and DVL samples up to now are in the start's prior: not used twice.
+  const auto before = [&](const auto& sample) { return sample.t_ns <= t_ns; };
+  pending_usbl_.erase(std::remove_if(pending_usbl_.begin(), pending_usbl_.end(), before),
+                      pending_usbl_.end());
+  pending_dvl_.erase(std::remove_if(pending_dvl_.begin(), pending_dvl_.end(), before),
+                     pending_dvl_.end());
+  StartWindow(*initial);
+  return true;
+}
+
+void SlidingWindowEstimator::StartWindow(const InitialState& initial) {
   auto state = std::make_unique<State>();
-  state->t_ns = frame.t_ns;
-  first_state_t_ns_ = frame.t_ns;
-  PoseToBlock(*frame.T_D_B_initial, state->pose);
+  state->t_ns = initial.t_ns;
+  first_state_t_ns_ = initial.t_ns;
+  PoseToBlock(initial.T_D_B, state->pose);
+  std::copy(initial.v_D.data(), initial.v_D.data() + 3, state->velocity);
   problem_->AddParameterBlock(state->pose, kPoseSize, pose_manifold_.get());
   problem_->AddParameterBlock(state->velocity, kVelocitySize);
   problem_->AddParameterBlock(state->bias, kBiasSize);
-
-  Matrix6d pose_cov = Matrix6d::Zero();
-  pose_cov.topLeftCorner<3, 3>().diagonal().setConstant(
-      std::pow(options_.init_position_sigma_m, 2));
-  pose_cov.bottomRightCorner<3, 3>().diagonal().setConstant(
-      std::pow(options_.init_attitude_sigma_rad, 2));
-  problem_->AddResidualBlock(PosePriorFactor::Create(*frame.T_D_B_initial, pose_cov), nullptr,
-                             state->pose);
-  problem_->AddResidualBlock(
-      VelocityPriorFactor::Create(Eigen::Vector3d::Zero(),
-                                  Eigen::Matrix3d::Identity() *
-                                      std::pow(options_.init_velocity_sigma_mps, 2)),
-      nullptr, state->velocity);
+  problem_->AddResidualBlock(PosePriorFactor::Create(initial.T_D_B, initial.pose_covariance),
+                             nullptr, state->pose);
+  problem_->AddResidualBlock(VelocityPriorFactor::Create(initial.v_D, initial.velocity_covariance),
+                             nullptr, state->velocity);
   Matrix6d bias_cov = Matrix6d::Zero();
   bias_cov.topLeftCorner<3, 3>().diagonal().setConstant(std::pow(options_.init_gyro_bias_sigma, 2));
   bias_cov.bottomRightCorner<3, 3>().diagonal().setConstant(
@@ -217,7 +256,6 @@ bool SlidingWindowEstimator::Initialize(const VisionFrame& frame) {
   problem_->AddResidualBlock(BiasPriorFactor::Create(Eigen::Matrix<double, 6, 1>::Zero(), bias_cov),
                              nullptr, state->bias);
   window_.push_back(std::move(state));
-  return true;
 }
 
 bool SlidingWindowEstimator::AddState(int64_t t_ns) {
@@ -246,6 +284,29 @@ bool SlidingWindowEstimator::AddState(int64_t t_ns) {
                              state->velocity, state->bias);
   window_.push_back(std::move(state));
   return true;
+}
+
+std::vector<double> SlidingWindowEstimator::SaveWindow() const {
+  std::vector<double> values;
+  values.reserve(window_.size() * (kPoseSize + kVelocitySize + kBiasSize));
+  for (const auto& state : window_) {
+    values.insert(values.end(), state->pose, state->pose + kPoseSize);
+    values.insert(values.end(), state->velocity, state->velocity + kVelocitySize);
+    values.insert(values.end(), state->bias, state->bias + kBiasSize);
+  }
+  return values;
+}
+
+void SlidingWindowEstimator::RestoreWindow(const std::vector<double>& values) {
+  auto it = values.begin();
+  for (const auto& state : window_) {
+    std::copy(it, it + kPoseSize, state->pose);
+    it += kPoseSize;
+    std::copy(it, it + kVelocitySize, state->velocity);
+    it += kVelocitySize;
+    std::copy(it, it + kBiasSize, state->bias);
+    it += kBiasSize;
+  }
 }
 
 bool SlidingWindowEstimator::Solve() {
@@ -317,6 +378,7 @@ void SlidingWindowEstimator::AddUsbl(const AcousticFix& fix) {
     return;
   }
   pending_usbl_.push_back(fix);
+  if (options_.acoustic_init.enabled) acoustic_init_.AddFix(fix);
 }
 
 void SlidingWindowEstimator::AddSblRange(const SblRange& range) {
@@ -393,6 +455,7 @@ void SlidingWindowEstimator::AddDvl(const DvlMeasurement& sample) {
   }
   last_dvl_sample_t_ns_ = sample.t_ns;
   pending_dvl_.push_back(sample);
+  if (options_.acoustic_init.enabled) acoustic_init_.AddDvl(sample);
 }
 
 StateBlocks SlidingWindowEstimator::BlocksOf(State& state) const {
@@ -594,7 +657,7 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   last_frame_t_ns_ = frame.t_ns;
 
   if (window_.empty()) {
-    if (!Initialize(frame)) return std::nullopt;
+    if (!Initialize(frame) && !InitializeAcoustically(frame.t_ns)) return std::nullopt;
   } else if (!AddState(frame.t_ns)) {
     // One reset per outage: while no IMU sample has come since the last reset for a gap, the
     // window restarts at each frame of the outage without counting it again.
@@ -604,7 +667,7 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
                             std::to_string(options_.max_imu_gap_s) + " s) up to " +
                             std::to_string(frame.t_ns) + " ns");
     imu_outage_newest_t_ns_ = imu_.newest_t_ns();
-    if (!Initialize(frame)) return std::nullopt;
+    if (!Initialize(frame) && !InitializeAcoustically(frame.t_ns)) return std::nullopt;
   }
   State* state = window_.back().get();
   VisionFactorOptions vision = options_.vision;
@@ -622,6 +685,7 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   std::vector<SensorResidual> usbl = AttachUsbl(frame.t_ns);
   std::vector<SensorResidual> sbl = AttachSbl(frame.t_ns);
 
+  const std::vector<double> warm_start = SaveWindow();
   if (!Solve()) {
     ++stats_.solver_failures;
     Reset("solver failed at " + std::to_string(frame.t_ns) + " ns");
@@ -657,9 +721,13 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
     dvl_rate_test_.Confirm(kept.t_ns);
     last_dvl_t_ns_ = std::max(last_dvl_t_ns_, kept.t_ns);
   }
-  if ((state->n_gated > 0 || depth_gated > 0 || dvl_gated > 0 || usbl_gated > 0 ||
-       sbl_gated > 0) &&
-      !Solve()) {
+  const bool any_gated = state->n_gated > 0 || depth_gated > 0 || dvl_gated > 0 ||
+                         usbl_gated > 0 || sbl_gated > 0;
+  // Re-solved from the warm start: the solution with the outliers in it can lie far from the one
+  // without them (a 1.5 m acoustic outlier pulled a window without lights by 0.4 m, and the
+  // solve back from there took 14 iterations).
+  if (any_gated) RestoreWindow(warm_start);
+  if (any_gated && !Solve()) {
     ++stats_.solver_failures;
     Reset("solver failed at " + std::to_string(frame.t_ns) + " ns (after gating)");
     return std::nullopt;

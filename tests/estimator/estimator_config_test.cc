@@ -20,6 +20,31 @@ TEST(EstimatorConfigTest, ShippedDefaultsEqualTheBuiltInOnes) {
             defaults.smoother_vision_correlation_time_s);
   EXPECT_EQ(config.estimator.window_size, defaults.window_size);
   EXPECT_EQ(config.estimator.adaptive_dvl_noise.enabled, defaults.adaptive_dvl_noise.enabled);
+  EXPECT_EQ(config.estimator.acoustic_init.enabled, defaults.acoustic_init.enabled);
+  EXPECT_EQ(config.estimator.acoustic_init.min_fixes, defaults.acoustic_init.min_fixes);
+  EXPECT_EQ(config.estimator.acoustic_init.max_span_s, defaults.acoustic_init.max_span_s);
+  EXPECT_EQ(config.estimator.acoustic_init.max_heading_sigma_rad,
+            defaults.acoustic_init.max_heading_sigma_rad);
+}
+
+TEST(EstimatorConfigTest, AcousticStartKeys) {
+  const test::TempDir dir;
+  const std::string path = dir.path() + "/estimator.yaml";
+  {
+    std::ofstream(path) << "estimator:\n  acoustic_init: false\n  acoustic_init_min_fixes: 6\n"
+                           "  acoustic_init_max_heading_sigma_rad: 0.05\n";
+  }
+  const RunConfig config = LoadRunConfig(path);
+  EXPECT_FALSE(config.estimator.acoustic_init.enabled);
+  EXPECT_EQ(config.estimator.acoustic_init.min_fixes, 6);
+  EXPECT_EQ(config.estimator.acoustic_init.max_heading_sigma_rad, 0.05);
+  { std::ofstream(path) << "estimator:\n  acoustic_init_min_fixes: 2\n"; }
+  try {
+    LoadRunConfig(path);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("acoustic_init_min_fixes"), std::string::npos) << e.what();
+  }
 }
 
 TEST(EstimatorConfigTest, AdaptiveDvlNoiseSwitch) {

@@ -838,5 +838,64 @@ TEST(SlidingWindowEstimatorTest, ImplausibleHeldAndBackwardSamplesAreRejectedWit
   EXPECT_LT(errors.max_position_m, 0.05);
 }
 
+// 30 m out, no light: the window starts from the fixes (late by up to 1 s), the DVL (with its
+// spikes) and the IMU, and holds the horizontal position within the long approach's target
+// (max(0.3 m, 1 % of the range)) with depth on; without the DVL it never starts.
+TEST(SlidingWindowEstimatorTest, StartsWithoutLightsFromTheAcousticFixesAndTheDvl) {
+  const test::SyntheticRun run = test::MakeSyntheticRun(test::LongApproachScenario(25.0), 4);
+  const std::vector<AcousticFix> fixes = test::MakeAcousticFixes(run, 5, 1.0);
+  for (const bool with_dvl : {true, false}) {
+    SlidingWindowEstimator estimator(run.calibration, run.dock);
+    size_t next_imu = 0, next_dvl = 0, next_depth = 0, next_fix = 0;
+    int first = -1, outputs = 0;
+    double max_xy = 0.0, max_ratio = 0.0;
+    for (size_t k = 0; k < run.frames.size(); ++k) {
+      const int64_t t = run.frames[k].t_ns;
+      while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= t) {
+        estimator.AddImu(run.imu[next_imu++]);
+      }
+      while (next_depth < run.depth.size() && run.depth[next_depth].t_ns <= t) {
+        estimator.AddDepth(run.depth[next_depth++]);
+      }
+      while (with_dvl && next_dvl < run.dvl.size() && run.dvl[next_dvl].t_ns <= t) {
+        estimator.AddDvl(run.dvl[next_dvl++]);
+      }
+      while (next_fix < fixes.size() && fixes[next_fix].arrival_t_ns() <= t) {
+        estimator.AddUsbl(fixes[next_fix++]);
+      }
+      ASSERT_TRUE(run.frames[k].mono.empty() && run.frames[k].stereo.empty()) << k;
+      const auto out = estimator.AddVisionFrame(run.frames[k]);
+      if (!out) {
+        EXPECT_EQ(first, -1) << "the window stopped at frame " << k;
+        continue;
+      }
+      if (first < 0) first = static_cast<int>(k);
+      ++outputs;
+      const Eigen::Vector3d& p_true = run.truth[k].T_D_B.p;
+      const double xy = (out->T_D_B.p - p_true).head<2>().norm();
+      max_xy = std::max(max_xy, xy);
+      max_ratio = std::max(max_ratio, xy / std::max(0.3, 0.01 * p_true.norm()));
+    }
+    const EstimatorStats& stats = estimator.stats();
+    if (!with_dvl) {
+      EXPECT_EQ(outputs, 0);
+      EXPECT_EQ(stats.acoustic_starts, 0);
+      EXPECT_THAT(estimator.init_refusal(), HasSubstr("DVL"));
+      continue;
+    }
+    std::printf("acoustic start at %.1f s; largest horizontal error %.3f m (%.2f of the target)\n",
+                (run.frames[first].t_ns - run.frames.front().t_ns) * 1e-9, max_xy, max_ratio);
+    EXPECT_EQ(stats.acoustic_starts, 1);
+    EXPECT_EQ(stats.resets, 0);
+    EXPECT_TRUE(std::any_of(stats.log.begin(), stats.log.end(), [](const std::string& line) {
+      return line.find("acoustic start at") != std::string::npos;
+    }));
+    ASSERT_GE(first, 0);
+    EXPECT_LT(run.frames[first].t_ns - run.frames.front().t_ns, 8'000'000'000);
+    EXPECT_LT(max_ratio, 1.0);
+    EXPECT_GE(stats.usbl_used, static_cast<int>(fixes.size()) - 10);
+  }
+}
+
 }  // namespace
 }  // namespace auvdock

@@ -1,6 +1,7 @@
 #include "tests/testing/synthetic_vision.h"
 
 #include <cmath>
+#include <random>
 
 #include "auvdock/sim/depth_simulator.h"
 #include "auvdock/sim/dvl_simulator.h"
@@ -130,6 +131,25 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
     run.truth.push_back({t, T_D_B});
   }
   return run;
+}
+
+std::vector<AcousticFix> MakeAcousticFixes(const SyntheticRun& run, uint64_t seed,
+                                           double max_latency_s) {
+  const AcousticCalibration& acoustic = *run.calibration.acoustic;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::uniform_real_distribution<double> latency(0.0, max_latency_s);
+  std::vector<AcousticFix> fixes;
+  for (size_t k = 3; k < run.truth.size(); k += 10) {
+    AcousticFix fix;
+    fix.t_ns = run.truth[k].t_ns;
+    const Eigen::Vector3d p_T = run.truth[k].T_D_B * acoustic.T_B_S.p;
+    fix.sigma_m = acoustic.sigma_min_m + acoustic.sigma_range_fraction * p_T.norm();
+    fix.p_D = p_T + fix.sigma_m * Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+    fix.latency_ns = static_cast<int64_t>(latency(rng) * 1e9);
+    fixes.push_back(fix);
+  }
+  return fixes;
 }
 
 std::map<size_t, EstimatorOutput> RunWindow(const SyntheticRun& run,

@@ -49,6 +49,11 @@ struct SyntheticPixelNoise {
 SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
                               const SyntheticPixelNoise& noise);
 
+// One acoustic fix of the transponder a second (the first 0.3 s in), with the calibration's
+// range-dependent sigma as its Gaussian error and a latency drawn from [0, max_latency_s].
+std::vector<AcousticFix> MakeAcousticFixes(const SyntheticRun& run, uint64_t seed,
+                                           double max_latency_s = 0.0);
+
 // Runs the sliding window over a run, frame by frame, feeding the IMU samples up to each frame
 // (with_sensors: the depth and DVL samples too); returns the outputs by frame index.
 std::map<size_t, EstimatorOutput> RunWindow(const SyntheticRun& run,

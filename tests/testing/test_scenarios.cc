@@ -8,6 +8,12 @@ std::string SourcePath(const std::string& relative) {
 
 Scenario DefaultScenario() { return LoadScenario(SourcePath("data/scenarios/default.yaml")); }
 
+Scenario LongApproachScenario(double duration_s) {
+  Scenario s = LoadScenario(SourcePath("data/scenarios/long_approach.yaml"));
+  s.duration_s = duration_s;
+  return s;
+}
+
 Scenario ShortScenario(double duration_s) {
   Scenario s = DefaultScenario();
   s.duration_s = duration_s;

@@ -13,5 +13,7 @@ std::string SourcePath(const std::string& relative);  // path inside the source 
 Scenario DefaultScenario();
 // The default scenario cut to `duration_s` seconds, with 160x128 images (same field of view).
 Scenario ShortScenario(double duration_s = 2.0);
+// data/scenarios/long_approach.yaml (30 m out, no light for its first ~35 s) cut to `duration_s`.
+Scenario LongApproachScenario(double duration_s);
 
 }  // namespace auvdock::test

@@ -17,7 +17,8 @@
 //
 // Each new frame: preintegrate the IMU since the previous state, predict the new state, add the
 // factors, solve (Levenberg-Marquardt, iteration and time budget), gate vision residuals whose
-// Mahalanobis distance exceeds the chi-square gate and re-solve without them, then marginalize
+// Mahalanobis distance exceeds the chi-square gate and re-solve without them (from the warm
+// start, not from the solution the outliers pulled), then marginalize
 // the oldest state into the prior when the window is full (estimator/marginalization.h), and
 // report the newest pose's marginal covariance (estimator/marginal_covariance.h).
 // Without vision the window carries on on the IMU alone; the covariance grows accordingly.
@@ -28,6 +29,10 @@
 // pose, zero velocity and zero biases, each with a prior (EstimatorOptions), unless the pose's
 // tilt disagrees with the accelerometer (init_max_tilt_error_rad). The attitude then refines
 // against gravity through the IMU factors (gravity_D is the dock's, not a constant).
+// Without lights (far from the dock): the acoustic start (estimator/acoustic_initializer.h), at
+// the first frame after a fix with which the fixes, the DVL's path and the IMU give a state (its
+// pose, velocity and their covariance as the priors); the window then runs on the acoustic, DVL,
+// depth and IMU factors, and the lights join it when they appear.
 // Reset: an IMU gap longer than max_imu_gap_s, or a failed solve, drops the window and waits
 // for the next per-frame pose; every reset is counted and logged, an IMU outage once however
 // many frames it lasts (the window restarts at each of them without a count).
@@ -50,6 +55,7 @@
 
 #include <Eigen/Core>
 
+#include "auvdock/estimator/acoustic_initializer.h"
 #include "auvdock/estimator/imu_buffer.h"
 #include "auvdock/estimator/stage_weighting.h"
 #include "auvdock/estimator/adaptive_noise_scale.h"
@@ -209,6 +215,10 @@ struct EstimatorOptions {
   double imu_noise_scale = 1.0;
   // Seed 001's rate-of-change test on each DVL sample before it joins (estimator/dvl_rate_test.h).
   DvlRateTestOptions dvl_rate_test;
+  // The start without lights from acoustic fixes, the DVL and the IMU (acoustic_initializer.h;
+  // needs use_usbl, use_dvl and both sensors). A frame with a per-frame pose starts the window
+  // first when it comes first.
+  AcousticInitOptions acoustic_init;
 };
 
 // The estimate at one state.
@@ -241,6 +251,7 @@ struct EstimatorStats {
   int used_observations = 0;
   int resets = 0;
   int init_refused = 0;  // per-frame poses refused as the first state (tilt against the IMU)
+  int acoustic_starts = 0;  // windows started without lights (acoustic_initializer.h)
   int solver_failures = 0;
   int covariance_failures = 0;
   int depth_used = 0;     // depth samples in the cost (after gating)
@@ -317,16 +328,24 @@ class SlidingWindowEstimator {
 
   const EstimatorStats& stats() const { return stats_; }
   bool initialized() const { return !window_.empty(); }
-  // Why the last frame with a per-frame pose did not start the window (empty if none did not).
+  // Why the last frame with a per-frame pose, or the last try of the acoustic start, did not
+  // start the window (empty if none did not).
   const std::string& init_refusal() const { return init_refusal_; }
 
  private:
   struct State;
 
   bool Initialize(const VisionFrame& frame);
+  // The acoustic start at t_ns, tried when a fix came since the last try.
+  bool InitializeAcoustically(int64_t t_ns);
+  // The window's first state with its priors (the biases' from EstimatorOptions).
+  void StartWindow(const InitialState& initial);
   void Reset(const std::string& reason);
   bool AddState(int64_t t_ns);
   bool Solve();
+  // The window's states (pose, velocity, bias of each, oldest first), and back.
+  std::vector<double> SaveWindow() const;
+  void RestoreWindow(const std::vector<double>& values);
   void MarginalizeOldest();
   // The pending depth samples up to t_ns onto the states at or before them; returns the
   // residuals added.
@@ -380,6 +399,7 @@ class SlidingWindowEstimator {
   AdaptiveNoiseScale sbl_noise_;                    // the SBL ranges' (adaptive_sbl_noise)
   std::vector<SecondDifference> sbl_innovations_;  // one per transducer
   UsblRateTest usbl_rate_test_;
+  AcousticInitializer acoustic_init_;
   std::vector<UsblRateTest> sbl_rate_tests_;  // one per transducer
   std::map<ceres::ResidualBlockId, int> sbl_transducer_of_;  // the newest frame's SBL residuals
   HeldDvlReadingCheck held_dvl_reading_;
