@@ -85,10 +85,10 @@ void Crlb(const CrlbOptions& options) {
     }
   }
   if (!options.quiet) std::fprintf(stderr, "\n");
-  const CramerRaoBound bound = ComputeCramerRaoBound(
-      dataset.calibration, dock, frames, dataset.imu, dataset.groundtruth, config.estimator,
-      NavigationSamples{dataset.depth, dataset.dvl, 1.0, 1.0, dataset.acoustic,
-                        dataset.sbl});
+  NavigationSamples sensors{dataset.depth, dataset.dvl, 1.0, 1.0, dataset.acoustic, dataset.sbl};
+  sensors.heading = dataset.heading;
+  const CramerRaoBound bound = ComputeCramerRaoBound(dataset.calibration, dock, frames, dataset.imu,
+                                                     dataset.groundtruth, config.estimator, sensors);
   cancel.ThrowIfCancelled();
   if (bound.poses.empty()) {
     throw InputError("crlb: no pose has a bound (" + std::to_string(bound.frames) + " frames, " +

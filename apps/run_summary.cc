@@ -43,6 +43,10 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                            {"gated", stats.sbl_gated},
                            {"rate_test_rejected", stats.sbl_rate_rejected},
                            {"skipped", stats.sbl_skipped}};
+  summary["heading_samples"] = {{"used", stats.heading_used},
+                                {"gated", stats.heading_gated},
+                                {"skipped", stats.heading_skipped}};
+  summary["acoustic_starts"] = stats.acoustic_starts;
   summary["no_vision_reasons"] = source.no_vision_reasons();
   if (source.replaying()) {
     const VisionFrameSource::GivenIdentityCounts& given = source.given_identities();

@@ -1,6 +1,6 @@
 // Feeds a dataset's sensor streams into the sliding window in time order, as `run` and `smooth`
 // both do: the IMU up to the time a prediction is asked for (causal: samples at or before it),
-// and before each frame every stream (IMU, depth, DVL, acoustic fixes, SBL ranges) up to the frame's last
+// and before each frame every stream (IMU, depth, DVL, heading, acoustic fixes, SBL ranges) up to the frame's last
 // image (an acoustic fix by its arrival time, AcousticFix::arrival_t_ns).
 #pragma once
 
@@ -33,6 +33,10 @@ class SensorFeed {
     while (next_dvl_ < dataset_.dvl.size() && dataset_.dvl[next_dvl_].t_ns <= t_ns) {
       estimator_->AddDvl(dataset_.dvl[next_dvl_++]);
     }
+    while (next_heading_ < dataset_.heading.size() &&
+           dataset_.heading[next_heading_].t_ns <= t_ns) {
+      estimator_->AddHeading(dataset_.heading[next_heading_++]);
+    }
     // A fix is fed when it has arrived (its measurement time is earlier; the window attaches it
     // there), in measurement order: one that overtook an earlier fix waits for it.
     while (next_usbl_ < dataset_.acoustic.size() &&
@@ -50,6 +54,7 @@ class SensorFeed {
   size_t next_imu_ = 0;
   size_t next_depth_ = 0;
   size_t next_dvl_ = 0;
+  size_t next_heading_ = 0;
   size_t next_usbl_ = 0;
   size_t next_sbl_ = 0;
 };

@@ -67,6 +67,7 @@ void RunSimulate(const SimulateOptions& options) {
               summary.n_camera_frames, simulator.calibration().cameras.size(), summary.n_imu,
               summary.n_depth, summary.n_dvl, summary.n_acoustic);
   if (simulator.calibration().sbl) std::printf("%d SBL ranges, ", summary.n_sbl_ranges);
+  if (simulator.calibration().heading) std::printf("%d heading, ", summary.n_heading);
   std::printf("%d faults\n", summary.n_faults);
   std::printf("  max speed %.2f m/s; stages:", summary.max_speed_mps);
   for (int i = 0; i < 4; ++i) {

@@ -86,12 +86,13 @@ void Smooth(const SmoothOptions& options) {
     };
   }
   const auto t0 = Clock::now();
-  const BatchResult result = SmoothBatch(
-      dataset.calibration, *dataset.dock, frames, dataset.imu, estimator.History(),
-      config.estimator, batch,
-      NavigationSamples{dataset.depth, dataset.dvl, estimator.stats().dvl_variance_factor,
-                        estimator.stats().depth_variance_factor, dataset.acoustic,
-                        dataset.sbl, estimator.stats().sbl_variance_factor});
+  NavigationSamples sensors{dataset.depth, dataset.dvl, estimator.stats().dvl_variance_factor,
+                            estimator.stats().depth_variance_factor, dataset.acoustic,
+                            dataset.sbl, estimator.stats().sbl_variance_factor};
+  sensors.heading = dataset.heading;
+  const BatchResult result =
+      SmoothBatch(dataset.calibration, *dataset.dock, frames, dataset.imu, estimator.History(),
+                  config.estimator, batch, sensors);
   counters.backend_s += Seconds(Clock::now() - t0);
   if (!options.quiet) std::fprintf(stderr, "\n");
 

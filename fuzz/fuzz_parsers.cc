@@ -39,7 +39,11 @@ void ReadSensorCsv(const uint8_t* data, size_t size) {
   std::vector<std::string> skipped_rows;
   std::vector<std::string>* skipped = (data[0] & 8) != 0 ? &skipped_rows : nullptr;
   const std::string path = WriteInput(data + 1, size - 1, "data.csv");
-  if ((data[0] & 16) != 0) {  // a later reader: its own bit, so the corpus keeps its meaning
+  if ((data[0] & 32) != 0) {  // a later reader: its own bit, so the corpus keeps its meaning
+    ReadHeadingCsv(path, skipped);
+    return;
+  }
+  if ((data[0] & 16) != 0) {
     ReadSblCsv(path, /*num_transducers=*/4, skipped);
     return;
   }

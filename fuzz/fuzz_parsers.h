@@ -9,8 +9,8 @@
 //   pose_covariance, decisions, rejections, light_labels: the file is the bytes;
 //   sensor_csv: the first byte chooses the reader (modulo 8: IMU, camera, depth, DVL, acoustic,
 //     ground truth, visibility, faults) and, for the sensors, whether bad rows are skipped
-//     (bit 3) or fatal; with bit 4 set, the SBL reader (4 transducers) instead; the rest is
-//     the file;
+//     (bit 3) or fatal; with bit 4 set, the SBL reader (4 transducers) instead, with bit 5
+//     set the heading (AHRS) reader; the rest is the file;
 //   euroc_sensor_yaml: the first byte chooses a EuRoC sequence's cam0/sensor.yaml (even) or
 //     imu0/sensor.yaml (odd), beside a one-row data.csv, read through LoadDataset on a mav0/
 //     folder; the rest is its text.

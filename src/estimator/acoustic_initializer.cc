@@ -71,11 +71,11 @@ Fit FitHeading(const std::vector<FixOnPath>& fixes, const Eigen::Vector3d& g,
 
 }  // namespace
 
-AcousticInitializer::AcousticInitializer(const Calibration& calibration,
-                                         const Eigen::Vector3d& gravity_D,
+AcousticInitializer::AcousticInitializer(const Calibration& calibration, const DockModel& dock,
                                          const AcousticInitOptions& options)
-    : options_(options) {
-  if (options.min_fixes < 3 || !(options.max_span_s > 0.0) || !(options.max_dvl_gap_s > 0.0) ||
+    : heading_sensor_(calibration.heading), options_(options) {
+  const Eigen::Vector3d& gravity_D = dock.gravity_D;
+  if (options.min_fixes < 3 || options.min_fixes_with_heading < 2 || !(options.max_span_s > 0.0) || !(options.max_dvl_gap_s > 0.0) ||
       !(options.max_heading_sigma_rad > 0.0) || !(options.gate_chi2 > 0.0) ||
       !(options.tilt_sigma_rad > 0.0) || !(options.gyro_bias_sigma >= 0.0) ||
       !(options.velocity_sigma_mps > 0.0)) {
@@ -83,6 +83,7 @@ AcousticInitializer::AcousticInitializer(const Calibration& calibration,
   }
   if (!(gravity_D.norm() > 0.0)) throw std::invalid_argument("AcousticInitializer: zero gravity");
   gravity_direction_D_ = gravity_D.normalized();
+  heading_reference_ = HeadingReference::OfDock(dock);
   usable_ = calibration.dvl.has_value() && calibration.acoustic.has_value();
   if (calibration.dvl) T_B_dvl_ = calibration.dvl->T_B_S;
   if (calibration.acoustic) p_B_transponder_ = calibration.acoustic->T_B_S.p;
@@ -96,6 +97,13 @@ void AcousticInitializer::AddFix(const AcousticFix& fix) {
   const int64_t oldest = fix.t_ns - static_cast<int64_t>(options_.max_span_s * kNsPerSecond);
   while (!fixes_.empty() && fixes_.front().t_ns < oldest) fixes_.pop_front();
   while (!dvl_.empty() && dvl_.front().t_ns < oldest) dvl_.pop_front();
+  while (!headings_.empty() && headings_.front().t_ns < oldest) headings_.pop_front();
+}
+
+void AcousticInitializer::AddHeading(const HeadingMeasurement& sample) {
+  if (!heading_sensor_ || !std::isfinite(sample.heading_rad)) return;
+  if (!headings_.empty() && sample.t_ns <= headings_.back().t_ns) return;
+  headings_.push_back(sample);
 }
 
 void AcousticInitializer::AddDvl(const DvlMeasurement& sample) {
@@ -111,6 +119,7 @@ void AcousticInitializer::AddDvl(const DvlMeasurement& sample) {
 void AcousticInitializer::Clear() {
   fixes_.clear();
   dvl_.clear();
+  headings_.clear();
   has_new_data_ = false;
 }
 
@@ -178,10 +187,32 @@ std::optional<InitialState> AcousticInitializer::Solve(const ImuBuffer& imu, int
     }
     on_path.push_back(p);
   }
+  // The heading sensor's newest sample on the path, turned into psi (header).
+  std::optional<double> measured_psi;
+  int64_t t_heading = 0;
+  if (heading_sensor_) {
+    for (auto it = headings_.rbegin(); it != headings_.rend(); ++it) {
+      if (it->t_ns > t_ns || it->t_ns < t0) continue;
+      size_t j = 0;
+      while (j + 1 < dvl_.size() && dvl_[j + 1].t_ns <= it->t_ns) ++j;
+      Eigen::Quaterniond q = q_W_B[j];
+      if (it->t_ns > dvl_[j].t_ns) {
+        const std::optional<ImuPreintegration> pim =
+            imu.Preintegrate(dvl_[j].t_ns, it->t_ns, zero_bias);
+        if (!pim) break;
+        q = (q * pim->delta_q()).normalized();
+      }
+      const Eigen::Vector3d a_W = q * (heading_sensor_->T_B_S.q * Eigen::Vector3d::UnitX());
+      measured_psi = WrapAngle(it->heading_rad - heading_reference_.HeadingOf(a_W));
+      t_heading = it->t_ns;
+      break;
+    }
+  }
+  const int needed = measured_psi ? options_.min_fixes_with_heading : options_.min_fixes;
   const int n_on_path = static_cast<int>(on_path.size());
-  if (n_on_path < options_.min_fixes) {
+  if (n_on_path < needed) {
     return fail(std::to_string(n_on_path) + " fixes on the DVL's path, " +
-                std::to_string(options_.min_fixes) + " needed");
+                std::to_string(needed) + " needed");
   }
 
   // Fit, dropping the worst outlier while one is beyond the gate.
@@ -190,8 +221,13 @@ std::optional<InitialState> AcousticInitializer::Solve(const ImuBuffer& imu, int
   int kept = n_on_path;
   double chi2_sum = 0.0;
   while (true) {
-    fit = FitHeading(on_path, g, p_B_transponder_, 0.0, &bodies);
-    fit = FitHeading(on_path, g, p_B_transponder_, fit.psi, &bodies);
+    if (measured_psi) {
+      fit = FitHeading(on_path, g, p_B_transponder_, *measured_psi, &bodies);
+      fit.psi = *measured_psi;
+    } else {
+      fit = FitHeading(on_path, g, p_B_transponder_, 0.0, &bodies);
+      fit = FitHeading(on_path, g, p_B_transponder_, fit.psi, &bodies);
+    }
     const Eigen::Matrix3d R = AboutGravity(g, fit.psi);
     const Eigen::Vector3d c = fit.b_bar - R * fit.d_bar;
     int worst = -1;
@@ -206,17 +242,18 @@ std::optional<InitialState> AcousticInitializer::Solve(const ImuBuffer& imu, int
         worst = i;
       }
     }
-    if (worst_chi2 <= options_.gate_chi2 || kept <= options_.min_fixes) break;
+    if (worst_chi2 <= options_.gate_chi2 || kept <= needed) break;
     on_path[worst].kept = false;
     --kept;
   }
-  if (kept < options_.min_fixes) {
+  if (kept < needed) {
     return fail(std::to_string(kept) + " fixes agree with the DVL's path, " +
-                std::to_string(options_.min_fixes) + " needed");
+                std::to_string(needed) + " needed");
   }
-  if (!(fit.lever_information > 0.0)) return fail("the vehicle has not moved");
-  const double fit_heading_sigma = 1.0 / std::sqrt(fit.lever_information);
-  if (fit_heading_sigma > options_.max_heading_sigma_rad) {
+  if (!measured_psi && !(fit.lever_information > 0.0)) return fail("the vehicle has not moved");
+  const double fit_heading_sigma =
+      measured_psi ? heading_sensor_->sigma_rad : 1.0 / std::sqrt(fit.lever_information);
+  if (!measured_psi && fit_heading_sigma > options_.max_heading_sigma_rad) {
     char text[160];
     std::snprintf(text, sizeof(text),
                   "the path so far gives the heading to %.1f deg (at most %.1f): moving on",
@@ -253,12 +290,15 @@ std::optional<InitialState> AcousticInitializer::Solve(const ImuBuffer& imu, int
   state.v_D = R * v_W[last];
   state.fixes_used = kept;
   state.fixes_rejected = n_on_path - kept;
+  state.heading_measured = measured_psi.has_value();
 
+  // The gyro bias's heading drift since the heading's time (the fits' mean time, or the sample's).
   const double t_s = Seconds(t_ns - t0);
-  const double drift = options_.gyro_bias_sigma * (t_s - fit.t_bar_s);
+  const double drift = options_.gyro_bias_sigma *
+                       (measured_psi ? Seconds(t_ns - t_heading) : t_s - fit.t_bar_s);
   const double var_psi = fit_heading_sigma * fit_heading_sigma + drift * drift;
   state.heading_sigma_rad = std::sqrt(var_psi);
-  const int dof = 3 * kept - 4;  // 3 per fix; c (3) and psi (1) fitted
+  const int dof = 3 * kept - (measured_psi ? 3 : 4);  // 3 per fix; c (3) and psi (1) fitted
   const double variance_factor = std::max(1.0, dof > 0 ? chi2_sum / dof : 1.0);
   const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - g * g.transpose();
   const Eigen::Vector3d j = g.cross(R * (d_t - fit.d_bar));

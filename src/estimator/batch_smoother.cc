@@ -231,6 +231,23 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
       }
     }
   }
+  std::vector<SensorResidual> heading_residuals;
+  if (estimator_options.use_heading && calibration.heading) {
+    for (const HeadingMeasurement& sample : sensors.heading) {
+      std::optional<ceres::ResidualBlockId> id;
+      if (BatchState* s = state_at_or_before(sample.t_ns)) {
+        id = AddHeadingFactor(&problem, sample, *calibration.heading, dock, blocks_of(s), s->t_ns);
+      }
+      if (id) {
+        heading_residuals.push_back({*id, sample.t_ns});
+      } else {
+        ++result.stats.heading_skipped;
+        result.rejections.push_back({sample.t_ns, calibration.heading->name, kNoStatistic,
+                                     std::isfinite(sample.heading_rad) ? kNoStateReason
+                                                                       : "not finite"});
+      }
+    }
+  }
   std::vector<SensorResidual> dvl_residuals;
   if (estimator_options.use_dvl && calibration.dvl) {
     HeldDvlReadingCheck held;
@@ -332,6 +349,10 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   const auto gate_usbl = [&] {
     return gate(&usbl_residuals, estimator_options.usbl_gate_chi2, calibration.acoustic);
   };
+  const auto gate_heading = [&] {
+    return gate(&heading_residuals, estimator_options.heading_gate_chi2, calibration.heading);
+  };
+  result.stats.heading_gated = gate_heading();
   result.stats.depth_gated = gate_depth();
   result.stats.dvl_gated = gate_dvl();
   result.stats.usbl_gated = gate_usbl();
@@ -358,11 +379,14 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   const int usbl_gated_after = gate_usbl();
   result.stats.usbl_gated += usbl_gated_after;
   result.stats.usbl_used = static_cast<int>(usbl_residuals.size());
+  const int heading_gated_after = gate_heading();
+  result.stats.heading_gated += heading_gated_after;
+  result.stats.heading_used = static_cast<int>(heading_residuals.size());
   const int sbl_gated_after = gate_sbl();
   result.stats.sbl_gated += sbl_gated_after;
   result.stats.sbl_used = static_cast<int>(sbl_residuals.size());
   if (gated > 0 || depth_gated_after > 0 || dvl_gated_after > 0 || usbl_gated_after > 0 ||
-      sbl_gated_after > 0) {
+      sbl_gated_after > 0 || heading_gated_after > 0) {
     ceres::Solve(solver, &problem, &summary);
   }
   std::stable_sort(result.rejections.begin(), result.rejections.end(),

@@ -42,6 +42,8 @@ RunConfig LoadRunConfig(const std::string& path) {
       est.GetPositive("dvl_rate_accel_sigma_mps2", e.dvl_rate_test.accel_sigma_mps2);
   e.dvl_rate_test.max_reference_age_s =
       est.GetPositive("dvl_rate_max_reference_age_s", e.dvl_rate_test.max_reference_age_s);
+  e.use_heading = est.GetBool("use_heading", e.use_heading);
+  e.heading_gate_chi2 = est.GetNonNegative("heading_gate_chi2", e.heading_gate_chi2);
   e.acoustic_init.enabled = est.GetBool("acoustic_init", e.acoustic_init.enabled);
   e.acoustic_init.min_fixes = est.GetInt("acoustic_init_min_fixes", e.acoustic_init.min_fixes);
   if (e.acoustic_init.min_fixes < 3) est.Fail("acoustic_init_min_fixes", "must be at least 3");

@@ -8,6 +8,7 @@
 
 #include "factors/depth_factor.h"
 #include "factors/dvl_factor.h"
+#include "factors/heading_factor.h"
 #include "factors/time_shifted_factor.h"
 #include "factors/sbl_range_factor.h"
 #include "factors/usbl_fix_factor.h"
@@ -37,6 +38,23 @@ std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
       problem,
       std::make_unique<DepthFactor>(sample.depth_m, calibration.sigma_m * std::sqrt(variance_factor),
                                     dock.origin_depth_m, dock.gravity_D, calibration.T_B_S.p),
+      *shift, HuberOrNone(huber_sigmas), state);
+}
+
+std::optional<ceres::ResidualBlockId> AddHeadingFactor(ceres::Problem* problem,
+                                                       const HeadingMeasurement& sample,
+                                                       const HeadingCalibration& calibration,
+                                                       const DockModel& dock,
+                                                       const StateBlocks& state,
+                                                       int64_t t_state_ns, double huber_sigmas) {
+  if (!std::isfinite(sample.heading_rad) || sample.t_ns < t_state_ns) return std::nullopt;
+  const std::optional<ImuPoseShift> shift =
+      ImuShiftFromState(state, t_state_ns, sample.t_ns - t_state_ns, dock.gravity_D);
+  if (!shift) return std::nullopt;
+  return AddOnState<HeadingFactor, kHeadingResidualSize>(
+      problem,
+      std::make_unique<HeadingFactor>(sample.heading_rad, calibration.sigma_rad,
+                                      calibration.T_B_S.q, HeadingReference::OfDock(dock)),
       *shift, HuberOrNone(huber_sigmas), state);
 }
 

@@ -70,7 +70,7 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
       depth_noise_(options.adaptive_depth_noise),
       sbl_noise_(options.adaptive_sbl_noise),
       usbl_rate_test_(options.usbl_rate_test),
-      acoustic_init_(calibration, dock.gravity_D, options.acoustic_init) {
+      acoustic_init_(calibration, dock, options.acoustic_init) {
   // An outlier's sample is kept out of the noise statistics (second_difference.h).
   SecondDifferenceOptions depth_innovation = options.depth_innovation;
   depth_innovation.outlier_cutoff = options.innovation_outlier_gates * options.depth_gate_chi2;
@@ -222,8 +222,9 @@ bool SlidingWindowEstimator::InitializeAcoustically(int64_t t_ns) {
   ++stats_.acoustic_starts;
   char text[200];
   std::snprintf(text, sizeof(text),
-                "acoustic start at %lld ns: %d fixes (%d left out), heading to %.1f deg",
+                "acoustic start at %lld ns: %d fixes (%d left out), heading %s to %.1f deg",
                 static_cast<long long>(t_ns), initial->fixes_used, initial->fixes_rejected,
+                initial->heading_measured ? "measured" : "from the path",
                 initial->heading_sigma_rad * 180.0 / M_PI);
   stats_.log.push_back(text);
   // The fixes and DVL samples up to now are in the start's prior: not used twice.
@@ -381,6 +382,24 @@ void SlidingWindowEstimator::AddUsbl(const AcousticFix& fix) {
   if (options_.acoustic_init.enabled) acoustic_init_.AddFix(fix);
 }
 
+void SlidingWindowEstimator::AddHeading(const HeadingMeasurement& sample) {
+  if (!options_.use_heading || !calibration_.heading) return;
+  std::string problem;
+  if (!std::isfinite(sample.heading_rad)) {
+    problem = "not finite";
+  } else if (sample.t_ns <= last_heading_sample_t_ns_) {
+    problem = "out of order or repeated";
+  }
+  if (!problem.empty()) {
+    ++stats_.heading_skipped;
+    rejections_.push_back({sample.t_ns, calibration_.heading->name, kNoStatistic, problem});
+    return;
+  }
+  last_heading_sample_t_ns_ = sample.t_ns;
+  pending_heading_.push_back(sample);
+  if (options_.acoustic_init.enabled) acoustic_init_.AddHeading(sample);
+}
+
 void SlidingWindowEstimator::AddSblRange(const SblRange& range) {
   if (!options_.use_sbl || !calibration_.sbl) return;
   std::string problem;
@@ -427,6 +446,17 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachSbl(int64_t t_ns) {
                              state.t_ns, sbl_noise_.factor(), options_.sensor_huber_sigmas);
                          if (id) sbl_transducer_of_[*id] = range.transducer;
                          return id;
+                       });
+}
+
+std::vector<SensorResidual> SlidingWindowEstimator::AttachHeading(int64_t t_ns) {
+  if (!calibration_.heading) return {};
+  return AttachPending(&pending_heading_, t_ns, calibration_.heading->name,
+                       &stats_.heading_skipped,
+                       [&](const HeadingMeasurement& sample, State& state) {
+                         return AddHeadingFactor(problem_.get(), sample, *calibration_.heading,
+                                                 dock_, BlocksOf(state), state.t_ns,
+                                                 options_.sensor_huber_sigmas);
                        });
 }
 
@@ -684,6 +714,7 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   std::vector<SensorResidual> dvl = AttachDvl(frame.t_ns);
   std::vector<SensorResidual> usbl = AttachUsbl(frame.t_ns);
   std::vector<SensorResidual> sbl = AttachSbl(frame.t_ns);
+  std::vector<SensorResidual> heading = AttachHeading(frame.t_ns);
 
   const std::vector<double> warm_start = SaveWindow();
   if (!Solve()) {
@@ -710,6 +741,8 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
       gate(&dvl, options_.dvl_gate_chi2, calibration_.dvl, &stats_.dvl_gated, &stats_.dvl_used);
   const int usbl_gated = gate(&usbl, options_.usbl_gate_chi2, calibration_.acoustic,
                               &stats_.usbl_gated, &stats_.usbl_used);
+  const int heading_gated = gate(&heading, options_.heading_gate_chi2, calibration_.heading,
+                                 &stats_.heading_gated, &stats_.heading_used);
   const int sbl_gated = gate(&sbl, options_.sbl_gate_chi2, calibration_.sbl, &stats_.sbl_gated,
                              &stats_.sbl_used);
   for (const SensorResidual& kept : usbl) usbl_rate_test_.Confirm(kept.t_ns);
@@ -722,7 +755,7 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
     last_dvl_t_ns_ = std::max(last_dvl_t_ns_, kept.t_ns);
   }
   const bool any_gated = state->n_gated > 0 || depth_gated > 0 || dvl_gated > 0 ||
-                         usbl_gated > 0 || sbl_gated > 0;
+                         usbl_gated > 0 || sbl_gated > 0 || heading_gated > 0;
   // Re-solved from the warm start: the solution with the outliers in it can lie far from the one
   // without them (a 1.5 m acoustic outlier pulled a window without lights by 0.4 m, and the
   // solve back from there took 14 iterations).

@@ -111,6 +111,15 @@ Calibration LoadCalibration(const std::string& path) {
     dvl.sigma_mps = n.GetPositive("sigma_mps");
     calibration.dvl = dvl;
   }
+  if (root.Has("heading")) {
+    const ConfigNode n = root.Child("heading");
+    HeadingCalibration heading;
+    heading.name = n.GetString("name", heading.name);
+    heading.T_B_S = GetTransform(n, "T_B_S", heading.T_B_S);
+    heading.rate_hz = n.GetPositive("rate_hz");
+    heading.sigma_rad = n.GetPositive("sigma_rad");
+    calibration.heading = heading;
+  }
   if (root.Has("acoustic")) {
     const ConfigNode n = root.Child("acoustic");
     AcousticCalibration ac;
@@ -193,6 +202,15 @@ void SaveCalibration(const Calibration& calibration, const std::string& path) {
     out << YAML::Key << "name" << YAML::Value << s.name;
     EmitNumber(out, "rate_hz", s.rate_hz);
     EmitNumber(out, "sigma_mps", s.sigma_mps);
+    EmitTransform(out, "T_B_S", s.T_B_S);
+    out << YAML::EndMap;
+  }
+  if (calibration.heading) {
+    const auto& s = *calibration.heading;
+    out << YAML::Key << "heading" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << s.name;
+    EmitNumber(out, "rate_hz", s.rate_hz);
+    EmitNumber(out, "sigma_rad", s.sigma_rad);
     EmitTransform(out, "T_B_S", s.T_B_S);
     out << YAML::EndMap;
   }

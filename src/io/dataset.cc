@@ -43,6 +43,10 @@ Dataset LoadAuvdockDataset(const fs::path& root, std::vector<std::string>* skipp
     const std::string csv = SensorCsv(root, ds.calibration.dvl->name);
     if (!csv.empty()) ds.dvl = ReadDvlCsv(csv, skipped);
   }
+  if (ds.calibration.heading) {
+    const std::string csv = SensorCsv(root, ds.calibration.heading->name);
+    if (!csv.empty()) ds.heading = ReadHeadingCsv(csv, skipped);
+  }
   if (ds.calibration.acoustic) {
     const std::string csv = SensorCsv(root, ds.calibration.acoustic->name);
     if (!csv.empty()) ds.acoustic = ReadAcousticCsv(csv, skipped);

@@ -37,6 +37,9 @@ DatasetWriter::DatasetWriter(const std::string& root, const Calibration& calibra
   if (calibration.imu) imu_ = OpenSensor(r, calibration.imu->name, kImuCsvHeader);
   if (calibration.depth) depth_ = OpenSensor(r, calibration.depth->name, kDepthCsvHeader);
   if (calibration.dvl) dvl_ = OpenSensor(r, calibration.dvl->name, kDvlCsvHeader);
+  if (calibration.heading) {
+    heading_ = OpenSensor(r, calibration.heading->name, kHeadingCsvHeader);
+  }
   if (calibration.acoustic) {
     acoustic_ = OpenSensor(r, calibration.acoustic->name, kAcousticCsvHeader);
   }
@@ -52,6 +55,7 @@ DatasetWriter::DatasetWriter(const std::string& root, const Calibration& calibra
 void DatasetWriter::AddImu(const ImuSample& s) { imu_->Line(ImuCsvRow(s)); }
 void DatasetWriter::AddDepth(const DepthMeasurement& m) { depth_->Line(DepthCsvRow(m)); }
 void DatasetWriter::AddDvl(const DvlMeasurement& m) { dvl_->Line(DvlCsvRow(m)); }
+void DatasetWriter::AddHeading(const HeadingMeasurement& m) { heading_->Line(HeadingCsvRow(m)); }
 void DatasetWriter::AddAcoustic(const AcousticFix& m) { acoustic_->Line(AcousticCsvRow(m)); }
 void DatasetWriter::AddSbl(const SblRange& m) { sbl_->Line(SblCsvRow(m)); }
 void DatasetWriter::AddVisibility(const VisibilityRecord& r) {
@@ -126,7 +130,7 @@ void DatasetWriter::WriteImageFile(const std::string& camera, int64_t t_ns,
 }
 
 void DatasetWriter::Close() {
-  for (auto* w : {&imu_, &depth_, &dvl_, &acoustic_, &sbl_, &groundtruth_, &visibility_, &faults_}) {
+  for (auto* w : {&imu_, &depth_, &dvl_, &heading_, &acoustic_, &sbl_, &groundtruth_, &visibility_, &faults_}) {
     if (*w) (*w)->Close();
   }
   for (auto& [name, w] : cameras_) w->Close();

@@ -1,5 +1,6 @@
 #include "auvdock/io/dock_io.h"
 
+#include <cmath>
 #include <set>
 
 #include <yaml-cpp/yaml.h>
@@ -26,6 +27,8 @@ DockModel LoadDockModel(const std::string& path) {
     root.Fail("gravity_D", "magnitude must be between 9 and 10.5 m/s^2");
   }
   dock.p_D_beacon = root.GetVector<3>("beacon_p_D", dock.p_D_beacon);
+  dock.heading_rad = root.GetDouble("heading_deg", dock.heading_rad * 180.0 / M_PI) * M_PI / 180.0;
+  if (!std::isfinite(dock.heading_rad)) root.Fail("heading_deg", "must be finite");
   dock.approach_direction_D =
       root.GetVector<3>("approach_direction_D", dock.approach_direction_D);
   const ConfigNode deck = root.ChildOrEmpty("deck");
@@ -66,6 +69,7 @@ void SaveDockModel(const DockModel& dock, const std::string& path) {
   EmitNumber(out, "origin_depth_m", dock.origin_depth_m);
   EmitVector3(out, "gravity_D", dock.gravity_D);
   EmitVector3(out, "beacon_p_D", dock.p_D_beacon);
+  if (dock.heading_rad != 0.0) EmitNumber(out, "heading_deg", dock.heading_rad * 180.0 / M_PI);
   if (dock.approach_direction_D.norm() > 0.0) {
     EmitVector3(out, "approach_direction_D", dock.approach_direction_D);
   }

@@ -12,6 +12,7 @@ const char kImuCsvHeader[] =
     "a_RS_S_x [m s^-2],a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]";
 const char kCameraCsvHeader[] = "#timestamp [ns],filename";
 const char kDepthCsvHeader[] = "#timestamp [ns],depth [m]";
+const char kHeadingCsvHeader[] = "#timestamp [ns],heading [rad]";
 const char kDvlCsvHeader[] = "#timestamp [ns],v_S_x [m s^-1],v_S_y [m s^-1],v_S_z [m s^-1]";
 const char kAcousticCsvHeader[] =
     "#timestamp [ns],p_D_x [m],p_D_y [m],p_D_z [m],sigma [m],latency [ns]";
@@ -131,6 +132,21 @@ std::vector<DepthMeasurement> ReadDepthCsv(const std::string& path,
     DepthMeasurement m;
     m.t_ns = ReadTime(reader, &previous);
     m.depth_m = reader.Double(1);
+    out.push_back(m);
+  }
+  return out;
+}
+
+std::vector<HeadingMeasurement> ReadHeadingCsv(const std::string& path,
+                                               std::vector<std::string>* skipped) {
+  CsvReader reader(path, {"timestamp", "heading"});
+  std::vector<HeadingMeasurement> out;
+  int64_t previous = kNoTime;
+  while (reader.Next()) {
+    if (SkipRow(reader, 1, &previous, skipped)) continue;
+    HeadingMeasurement m;
+    m.t_ns = ReadTime(reader, &previous);
+    m.heading_rad = reader.Double(1);
     out.push_back(m);
   }
   return out;
@@ -277,6 +293,8 @@ std::string ImuCsvRow(const ImuSample& s) {
 }
 
 std::string DepthCsvRow(const DepthMeasurement& m) { return Join(m.t_ns, {m.depth_m}); }
+
+std::string HeadingCsvRow(const HeadingMeasurement& m) { return Join(m.t_ns, {m.heading_rad}); }
 
 std::string DvlCsvRow(const DvlMeasurement& m) {
   return Join(m.t_ns, {m.v_S.x(), m.v_S.y(), m.v_S.z()});

@@ -13,6 +13,7 @@
 #include "auvdock/sim/acoustic_simulator.h"
 #include "auvdock/sim/sbl_simulator.h"
 #include "auvdock/sim/depth_simulator.h"
+#include "auvdock/sim/heading_simulator.h"
 #include "auvdock/sim/dvl_simulator.h"
 #include "auvdock/sim/imu_simulator.h"
 #include "auvdock/sim/random_stream.h"
@@ -91,6 +92,10 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
   DvlSimulator dvl(s.dvl, s.dvl_faults, noisy, MakeRandomStream(s.seed, RandomStreamId::kDvl));
   AcousticSimulator acoustic(s.acoustic, s.dock, s.acoustic_faults, noisy,
                              MakeRandomStream(s.seed, RandomStreamId::kAcoustic));
+  std::optional<HeadingSimulator> heading;
+  if (s.heading) {
+    heading.emplace(*s.heading, s.dock, noisy, MakeRandomStream(s.seed, RandomStreamId::kHeading));
+  }
   std::optional<SblSimulator> sbl;
   if (s.sbl) {
     sbl.emplace(*s.sbl, s.dock, s.sbl_faults, noisy, MakeRandomStream(s.seed, RandomStreamId::kSbl));
@@ -110,8 +115,9 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
   const int64_t n_dvl = SampleCount(s.duration_s, s.dvl.rate_hz);
   const int64_t n_acoustic = SampleCount(s.duration_s, s.acoustic.rate_hz);
   const int64_t n_sbl = s.sbl ? SampleCount(s.duration_s, s.sbl->rate_hz) : 0;
+  const int64_t n_heading = s.heading ? SampleCount(s.duration_s, s.heading->rate_hz) : 0;
   const int64_t n_frames = SampleCount(s.duration_s, s.cameras.rate_hz);
-  int64_t k_imu = 0, k_depth = 0, k_dvl = 0, k_acoustic = 0, k_sbl = 0;
+  int64_t k_imu = 0, k_depth = 0, k_dvl = 0, k_acoustic = 0, k_sbl = 0, k_heading = 0;
 
   auto record_fault = [&](const std::optional<FaultRecord>& fault) {
     if (fault) {
@@ -143,6 +149,12 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
       if (!sample) continue;  // no bottom lock: no sample
       writer.AddDvl(*sample);
       ++summary.n_dvl;
+    }
+    for (; k_heading < n_heading && SampleTime(k_heading, s.heading->rate_hz) <= t_end_ns;
+         ++k_heading) {
+      const int64_t t = SampleTime(k_heading, s.heading->rate_hz);
+      writer.AddHeading(heading->Sample(t, trajectory_.At(Seconds(t))));
+      ++summary.n_heading;
     }
     for (; k_acoustic < n_acoustic && SampleTime(k_acoustic, s.acoustic.rate_hz) <= t_end_ns;
          ++k_acoustic) {

@@ -217,6 +217,16 @@ Scenario LoadScenario(const std::string& path) {
     ac.Fail("latency_max_s", "must not be below latency_min_s");
   }
   if (root.Has("sbl")) s.sbl = LoadSbl(root.Child("sbl"), &s.sbl_faults);
+  if (root.Has("heading")) {
+    const ConfigNode n = root.Child("heading");
+    HeadingCalibration heading;
+    heading.rate_hz = n.GetPositive("rate_hz", heading.rate_hz);
+    heading.sigma_rad = n.GetPositive("sigma_deg", heading.sigma_rad * 180.0 / M_PI) * M_PI / 180.0;
+    const double yaw = n.GetDouble("yaw_deg", 0.0) * M_PI / 180.0;
+    if (!std::isfinite(yaw)) n.Fail("yaw_deg", "must be finite");
+    heading.T_B_S.q = Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()));
+    s.heading = heading;
+  }
 
   root.CheckNoUnknownKeys();
   return s;
@@ -276,6 +286,7 @@ Calibration MakeCalibration(const Scenario& s) {
   cal.dvl = s.dvl;
   cal.acoustic = s.acoustic;
   cal.sbl = s.sbl;
+  cal.heading = s.heading;
   return cal;
 }
 

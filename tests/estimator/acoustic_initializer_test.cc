@@ -51,7 +51,7 @@ TEST(AcousticInitializerTest, GivesTheHeadingAndPositionWithinTheirSigmasOnceThe
   const test::SyntheticRun run = MakeFarApproach();
   const std::vector<AcousticFix> fixes = test::MakeAcousticFixes(run, 11);
   ImuBuffer imu(*run.calibration.imu, 0.1);
-  AcousticInitializer init(run.calibration, run.dock.gravity_D);
+  AcousticInitializer init(run.calibration, run.dock);
   Fed fed;
   std::string why;
   int first = -1;
@@ -100,7 +100,7 @@ TEST(AcousticInitializerTest, SaysWhyBeforeEnoughFixesAndLeavesAMultipathFixOut)
   std::vector<AcousticFix> fixes = test::MakeAcousticFixes(run, 12);
   fixes[2].p_D.y() += 3.0;  // a multipath fix 3 m off
   ImuBuffer imu(*run.calibration.imu, 0.1);
-  AcousticInitializer init(run.calibration, run.dock.gravity_D);
+  AcousticInitializer init(run.calibration, run.dock);
   Fed fed;
   std::string why;
   // After 2 fixes: not enough.
@@ -129,7 +129,7 @@ TEST(AcousticInitializerTest, NeedsBothSensorsAndForgetsThePathBeforeADvlGap) {
     Calibration no_dvl = run.calibration;
     no_dvl.dvl.reset();
     ImuBuffer imu(*run.calibration.imu, 0.1);
-    AcousticInitializer init(no_dvl, run.dock.gravity_D);
+    AcousticInitializer init(no_dvl, run.dock);
     Fed fed;
     std::string why;
     FeedUpTo(run, fixes, run.frames.back().t_ns, &imu, &init, &fed);
@@ -142,7 +142,7 @@ TEST(AcousticInitializerTest, NeedsBothSensorsAndForgetsThePathBeforeADvlGap) {
     if (t > 8.0 && t < 10.0) d.v_S.setConstant(std::numeric_limits<double>::quiet_NaN());
   }
   ImuBuffer imu(*run.calibration.imu, 0.1);
-  AcousticInitializer init(run.calibration, run.dock.gravity_D);
+  AcousticInitializer init(run.calibration, run.dock);
   Fed fed;
   std::string why;
   const int64_t t_after = run.dvl.front().t_ns + 11'500'000'000;
@@ -155,9 +155,46 @@ TEST(AcousticInitializerTest, RejectsOptionsOutOfRange) {
   const test::SyntheticRun run = MakeFarApproach();
   AcousticInitOptions options;
   options.min_fixes = 2;
-  EXPECT_THROW(AcousticInitializer(run.calibration, run.dock.gravity_D, options),
+  EXPECT_THROW(AcousticInitializer(run.calibration, run.dock, options),
                std::invalid_argument);
-  EXPECT_THROW(AcousticInitializer(run.calibration, Eigen::Vector3d::Zero()), std::invalid_argument);
+  DockModel weightless = run.dock;
+  weightless.gravity_D.setZero();
+  EXPECT_THROW(AcousticInitializer(run.calibration, weightless), std::invalid_argument);
+}
+
+// With an AHRS (2 degrees) the heading is measured: two fixes that agree start it, within about
+// two seconds, with the heading within 3 of the sensor's sigma.
+TEST(AcousticInitializerTest, WithAHeadingSensorTwoFixesSuffice) {
+  Scenario scenario = test::LongApproachScenario(20.0);
+  scenario.dvl_faults.gross_error_probability = 0.0;
+  scenario.heading = HeadingCalibration{};
+  scenario.heading->sigma_rad = 2.0 * M_PI / 180.0;
+  scenario.dock.heading_rad = 1.0;
+  const test::SyntheticRun run = test::MakeSyntheticRun(scenario, 3);
+  ASSERT_FALSE(run.heading.empty());
+  const std::vector<AcousticFix> fixes = test::MakeAcousticFixes(run, 14);
+  ImuBuffer imu(*run.calibration.imu, 0.1);
+  AcousticInitializer init(run.calibration, run.dock);
+  Fed fed;
+  size_t next_heading = 0;
+  std::string why;
+  for (size_t k = 0; k < run.frames.size(); ++k) {
+    const int64_t t = run.frames[k].t_ns;
+    FeedUpTo(run, fixes, t, &imu, &init, &fed);
+    while (next_heading < run.heading.size() && run.heading[next_heading].t_ns <= t) {
+      init.AddHeading(run.heading[next_heading++]);
+    }
+    const std::optional<InitialState> state = init.Solve(imu, t, &why);
+    if (!state) continue;
+    EXPECT_TRUE(state->heading_measured);
+    EXPECT_EQ(state->fixes_used, 2);
+    EXPECT_LT(t - run.frames.front().t_ns, 2'000'000'000) << "started at frame " << k;
+    EXPECT_LE(std::abs(HeadingError(state->T_D_B, run.truth[k].T_D_B)),
+              3.0 * state->heading_sigma_rad);
+    EXPECT_LT((state->T_D_B.p - run.truth[k].T_D_B.p).head<2>().norm(), 0.5);
+    return;
+  }
+  FAIL() << "no start: " << why;
 }
 
 }  // namespace

@@ -897,5 +897,51 @@ TEST(SlidingWindowEstimatorTest, StartsWithoutLightsFromTheAcousticFixesAndTheDv
   }
 }
 
+// The same with an AHRS (2 degrees): two fixes and the measured heading start the window within
+// about two seconds (the second fix's measurement and latency), within the target from there.
+TEST(SlidingWindowEstimatorTest, AHeadingSensorStartsTheWindowFromTwoFixes) {
+  Scenario scenario = test::LongApproachScenario(25.0);
+  scenario.heading = HeadingCalibration{};
+  scenario.heading->sigma_rad = 2.0 * M_PI / 180.0;
+  const test::SyntheticRun run = test::MakeSyntheticRun(scenario, 4);
+  const std::vector<AcousticFix> fixes = test::MakeAcousticFixes(run, 5, 1.0);
+  SlidingWindowEstimator estimator(run.calibration, run.dock);
+  size_t next_imu = 0, next_dvl = 0, next_heading = 0, next_fix = 0;
+  int first = -1;
+  double max_xy = 0.0;
+  for (size_t k = 0; k < run.frames.size(); ++k) {
+    const int64_t t = run.frames[k].t_ns;
+    while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= t) {
+      estimator.AddImu(run.imu[next_imu++]);
+    }
+    while (next_dvl < run.dvl.size() && run.dvl[next_dvl].t_ns <= t) {
+      estimator.AddDvl(run.dvl[next_dvl++]);
+    }
+    while (next_heading < run.heading.size() && run.heading[next_heading].t_ns <= t) {
+      estimator.AddHeading(run.heading[next_heading++]);
+    }
+    while (next_fix < fixes.size() && fixes[next_fix].arrival_t_ns() <= t) {
+      estimator.AddUsbl(fixes[next_fix++]);
+    }
+    const auto out = estimator.AddVisionFrame(run.frames[k]);
+    if (!out) continue;
+    if (first < 0) first = static_cast<int>(k);
+    max_xy = std::max(max_xy, (out->T_D_B.p - run.truth[k].T_D_B.p).head<2>().norm());
+  }
+  ASSERT_GE(first, 0);
+  const double start_s = (run.frames[first].t_ns - run.frames.front().t_ns) * 1e-9;
+  std::printf("acoustic start with a heading sensor at %.1f s; largest horizontal error %.3f m\n",
+              start_s, max_xy);
+  EXPECT_LT(start_s, 2.5);
+  EXPECT_LT(max_xy, 0.3);  // measured 0.216 m (the first estimate rests on two 0.2 m fixes)
+  const EstimatorStats& stats = estimator.stats();
+  EXPECT_EQ(stats.acoustic_starts, 1);
+  EXPECT_GT(stats.heading_used, 150);
+  EXPECT_LT(stats.heading_gated, 5);
+  EXPECT_TRUE(std::any_of(stats.log.begin(), stats.log.end(), [](const std::string& line) {
+    return line.find("heading measured") != std::string::npos;
+  }));
+}
+
 }  // namespace
 }  // namespace auvdock

@@ -25,7 +25,11 @@ void ExpectPoseEq(const Pose3& a, const Pose3& b) {
 
 TEST(DatasetRoundTrip, EveryRecordReadsBackIdentically) {
   test::TempDir tmp;
-  const Scenario scenario = test::DefaultScenario();
+  Scenario scenario = test::DefaultScenario();
+  scenario.heading = HeadingCalibration{};  // an AHRS turned 5 degrees to starboard, 1.5 deg
+  scenario.heading->sigma_rad = 0.026;
+  scenario.heading->T_B_S.q = Eigen::Quaterniond(Eigen::AngleAxisd(0.087, Eigen::Vector3d::UnitZ()));
+  scenario.dock.heading_rad = -2.4;  // the dock's x axis heads 137.5 degrees west of north
   const Calibration calibration = MakeCalibration(scenario);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-3.0, 3.0);
@@ -35,6 +39,7 @@ TEST(DatasetRoundTrip, EveryRecordReadsBackIdentically) {
   std::vector<GroundTruthState> gt;
   std::vector<DepthMeasurement> depth;
   std::vector<DvlMeasurement> dvl;
+  std::vector<HeadingMeasurement> heading;
   std::vector<AcousticFix> acoustic;
   std::vector<VisibilityRecord> visibility;
   std::vector<FaultRecord> faults;
@@ -49,6 +54,7 @@ TEST(DatasetRoundTrip, EveryRecordReadsBackIdentically) {
                     v3(), v3() * 1e-4, v3() * 1e-2});
       depth.push_back({t, 30.0 + u(rng)});
       dvl.push_back({t, v3() / 3.0});
+      heading.push_back({t, u(rng)});
       acoustic.push_back({t, v3(), 0.05 + std::abs(u(rng)), 200000000 + 1000 * k});
       visibility.push_back({t, k % 7, k % 5, k % 4,
                             StageFromLightCounts(k % 7, k % 5, k % 4)});
@@ -57,6 +63,7 @@ TEST(DatasetRoundTrip, EveryRecordReadsBackIdentically) {
       writer.AddGroundTruth(gt.back());
       writer.AddDepth(depth.back());
       writer.AddDvl(dvl.back());
+      writer.AddHeading(heading.back());
       writer.AddAcoustic(acoustic.back());
       writer.AddVisibility(visibility.back());
       writer.AddFault(faults.back());
@@ -80,6 +87,8 @@ TEST(DatasetRoundTrip, EveryRecordReadsBackIdentically) {
     EXPECT_EQ(ds.groundtruth[i].accel_bias, gt[i].accel_bias);
     EXPECT_EQ(ds.depth[i].depth_m, depth[i].depth_m);
     EXPECT_EQ(ds.dvl[i].v_S, dvl[i].v_S);
+    EXPECT_EQ(ds.heading[i].t_ns, heading[i].t_ns);
+    EXPECT_EQ(ds.heading[i].heading_rad, heading[i].heading_rad);
     EXPECT_EQ(ds.acoustic[i].p_D, acoustic[i].p_D);
     EXPECT_EQ(ds.acoustic[i].sigma_m, acoustic[i].sigma_m);
     EXPECT_EQ(ds.acoustic[i].latency_ns, acoustic[i].latency_ns);
@@ -101,6 +110,12 @@ TEST(DatasetRoundTrip, EveryRecordReadsBackIdentically) {
   }
   EXPECT_EQ(ds.calibration.imu->accelerometer_random_walk, calibration.imu->accelerometer_random_walk);
   EXPECT_EQ(ds.calibration.acoustic->sigma_range_fraction, calibration.acoustic->sigma_range_fraction);
+  ASSERT_TRUE(ds.calibration.heading.has_value());
+  EXPECT_EQ(ds.calibration.heading->name, "ahrs0");
+  EXPECT_EQ(ds.calibration.heading->sigma_rad, calibration.heading->sigma_rad);
+  EXPECT_LT((ds.calibration.heading->T_B_S.Matrix() - calibration.heading->T_B_S.Matrix()).norm(),
+            1e-15);
+  ASSERT_EQ(ds.heading.size(), heading.size());
   ASSERT_TRUE(ds.dock.has_value());
   ASSERT_EQ(ds.dock->lights.size(), scenario.dock.lights.size());
   for (std::size_t i = 0; i < scenario.dock.lights.size(); ++i) {
@@ -108,6 +123,7 @@ TEST(DatasetRoundTrip, EveryRecordReadsBackIdentically) {
     EXPECT_EQ(ds.dock->lights[i].p_D, scenario.dock.lights[i].p_D);
   }
   EXPECT_EQ(ds.dock->gravity_D, scenario.dock.gravity_D);
+  EXPECT_NEAR(ds.dock->heading_rad, scenario.dock.heading_rad, 1e-15);
   // Images are lossless.
   ASSERT_EQ(ds.camera_frames.at("cam1").size(), 3u);
   const cv::Mat back = cv::imread(ds.camera_frames.at("cam1")[2].path, cv::IMREAD_UNCHANGED);

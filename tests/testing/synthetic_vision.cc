@@ -5,6 +5,7 @@
 
 #include "auvdock/sim/depth_simulator.h"
 #include "auvdock/sim/dvl_simulator.h"
+#include "auvdock/sim/heading_simulator.h"
 #include "auvdock/sim/docking_simulator.h"
 #include "auvdock/sim/imu_simulator.h"
 #include "auvdock/sim/random_stream.h"
@@ -73,6 +74,15 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
         dvl.Sample(t, simulator.trajectory().At(simulator.Seconds(t)), &fault);
     if (fault) run.dvl_faults.push_back(*fault);
     if (sample) run.dvl.push_back(*sample);
+  }
+
+  if (scenario.heading) {
+    HeadingSimulator heading(*scenario.heading, scenario.dock, true, MakeRandomStream(seed, 106));
+    for (int64_t k = 0;; ++k) {
+      const int64_t t = simulator.SampleTime(k, scenario.heading->rate_hz);
+      if (simulator.Seconds(t) > scenario.duration_s) break;
+      run.heading.push_back(heading.Sample(t, simulator.trajectory().At(simulator.Seconds(t))));
+    }
   }
 
   std::mt19937_64 rng = MakeRandomStream(seed, 102);

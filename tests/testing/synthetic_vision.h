@@ -32,6 +32,7 @@ struct SyntheticRun {
   std::vector<DepthMeasurement> depth;  // the scenario's depth sensor (sim/depth_simulator.h)
   std::vector<DvlMeasurement> dvl;      // the scenario's DVL, gross errors included
   std::vector<FaultRecord> dvl_faults;  // its faults (sim/dvl_simulator.h)
+  std::vector<HeadingMeasurement> heading;  // the scenario's AHRS, if it has one
 };
 
 SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed, double pixel_sigma = 0.3);

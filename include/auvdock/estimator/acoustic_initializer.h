@@ -35,7 +35,13 @@
 //
 // The state is given only when at least min_fixes fixes are kept and sigma_psi (the fit's
 // part) is at most max_heading_sigma_rad: the vehicle has moved far enough, in a straight line
-// or not, for the fixes to show its heading. Fixes and DVL samples older than max_span_s before
+// or not, for the fixes to show its heading.
+//
+// With a heading sensor (the calibration's `heading`, an AHRS or compass; geometry/heading.h)
+// the heading is measured instead: psi = wrap(h - heading(R_W_B(t_h) R_B_S e_x)) from its
+// newest sample h at t_h on the path, sigma_psi^2 = sigma_h^2 + (gyro_bias_sigma (t - t_h))^2,
+// and only c is fitted (3 n - 3 dof). Then min_fixes_with_heading fixes that agree suffice (two:
+// one alone could be an outlier that nothing contradicts), the first within about two seconds. Fixes and DVL samples older than max_span_s before
 // the newest fix are forgotten; so is everything before a DVL gap (bottom lock lost, a stop)
 // longer than max_dvl_gap_s, since the path cannot be traced across it.
 //
@@ -50,6 +56,8 @@
 #include <Eigen/Core>
 
 #include "auvdock/estimator/imu_buffer.h"
+#include "auvdock/geometry/dock_model.h"
+#include "auvdock/geometry/heading.h"
 #include "auvdock/geometry/pose3.h"
 #include "auvdock/io/calibration.h"
 #include "auvdock/io/measurements.h"
@@ -59,6 +67,7 @@ namespace auvdock {
 struct AcousticInitOptions {
   bool enabled = true;
   int min_fixes = 4;
+  int min_fixes_with_heading = 2;  // with a heading sensor
   double max_span_s = 30.0;
   double max_dvl_gap_s = 1.0;
   double max_heading_sigma_rad = 0.1;  // about 6 degrees
@@ -78,18 +87,21 @@ struct InitialState {
   int fixes_used = 0;       // fixes kept by the fit
   int fixes_rejected = 0;   // outliers dropped by the fit
   double heading_sigma_rad = 0.0;
+  bool heading_measured = false;  // from the heading sensor, not the path
 };
 
 class AcousticInitializer {
  public:
   // Needs the calibration's DVL and acoustic sensors (without either, Solve never gives a state);
-  // gravity_D the dock's gravity. Throws std::invalid_argument for options out of range.
-  AcousticInitializer(const Calibration& calibration, const Eigen::Vector3d& gravity_D,
+  // the dock's gravity and heading reference. Throws std::invalid_argument for options out of
+  // range.
+  AcousticInitializer(const Calibration& calibration, const DockModel& dock,
                       const AcousticInitOptions& options = {});
 
   // Samples in time order (an older sample than the newest is ignored); non-finite ones ignored.
   void AddFix(const AcousticFix& fix);
   void AddDvl(const DvlMeasurement& sample);
+  void AddHeading(const HeadingMeasurement& sample);  // ignored without the heading sensor
   void Clear();
 
   // True when a fix came since the last Solve (the caller tries again with each new fix).
@@ -108,9 +120,12 @@ class AcousticInitializer {
   Pose3 T_B_dvl_;
   Eigen::Vector3d p_B_transponder_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d gravity_direction_D_ = Eigen::Vector3d::UnitZ();
+  std::optional<HeadingCalibration> heading_sensor_;
+  HeadingReference heading_reference_;
   AcousticInitOptions options_;
   std::deque<AcousticFix> fixes_;
   std::deque<DvlMeasurement> dvl_;
+  std::deque<HeadingMeasurement> headings_;
   bool has_new_data_ = false;
 };
 

@@ -88,6 +88,7 @@ struct NavigationSamples {
   std::vector<AcousticFix> usbl;        // acoustic fixes (estimator_options.use_usbl)
   std::vector<SblRange> sbl;            // SBL ranges (estimator_options.use_sbl)
   double sbl_variance_factor = 1.0;     // the window's adaptive estimate for the SBL ranges
+  std::vector<HeadingMeasurement> heading;  // an AHRS or compass (estimator_options.use_heading)
 };
 
 // frames: every vision frame of the log, in time order (frames without a warm-start state are

@@ -16,6 +16,7 @@
 //                                  the fix's own sigma (range-dependent, from the sensor)
 //   SBL    factors/sbl_range_factor.h  1 residual per range, on the pose (and the velocity
 //                                  when shifted); the range's own sigma
+//   heading factors/heading_factor.h  1 residual, on the pose's rotation (an AHRS or compass)
 #pragma once
 
 #include <cstdint>
@@ -48,6 +49,15 @@ std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
                                                      const StateBlocks& state, int64_t t_state_ns,
                                                      double variance_factor = 1.0,
                                                      double huber_sigmas = kNoRobustLoss);
+
+// The same for a heading sample (an AHRS or compass; the dock's heading_rad as its reference).
+std::optional<ceres::ResidualBlockId> AddHeadingFactor(ceres::Problem* problem,
+                                                       const HeadingMeasurement& sample,
+                                                       const HeadingCalibration& calibration,
+                                                       const DockModel& dock,
+                                                       const StateBlocks& state,
+                                                       int64_t t_state_ns,
+                                                       double huber_sigmas = kNoRobustLoss);
 
 // The same for a DVL sample; nothing also when the IMU has no gyro sample at its time. A sample
 // that is not finite (bottom lock lost) is no measurement.

@@ -9,6 +9,7 @@
 // + sum_k sum_lights w_stereo(k) rho(|r_stereo|^2)   triangulated lights against the dock model
 // + sum_depth |r_depth|^2                            pressure depth against the dock's depth
 // + sum_dvl |r_dvl|^2                                DVL velocity over ground, in its frame
+// + USBL fixes, SBL ranges, AHRS/compass headings      (estimator/sensor_factors.h)
 // where every r is whitened by its own noise model (pixel noise, triangulation covariance,
 // preintegrated IMU covariance), rho is a Huber loss, and w are the stage weights
 // (estimator/stage_weighting.h: by default pure information weighting, w = 1). This is the
@@ -188,6 +189,10 @@ struct EstimatorOptions {
   // each range on its own, 1 dof, p = 0.999, with its own sigma.
   bool use_sbl = true;
   double sbl_gate_chi2 = 10.83;
+  // Heading samples of an AHRS or compass (the same, needs the calibration's heading sensor and
+  // the dock's heading_rad): 1 dof, p = 0.999.
+  bool use_heading = true;
+  double heading_gate_chi2 = 10.83;
   // The Huber threshold (whitened norm) of the depth, DVL, USBL and SBL residuals: their gates
   // act after the solve, and without a bounded influence one absurd sample (a depth of 1e9 m)
   // drags the whole window in that solve, every light out of its gate with it. Wider than the
@@ -270,6 +275,9 @@ struct EstimatorStats {
   int sbl_gated = 0;      // beyond the SBL gate
   int sbl_skipped = 0;    // not finite, unknown transducer, out of order, no state or IMU
   int sbl_rate_rejected = 0;  // failed the rate-of-change test
+  int heading_used = 0;     // heading samples in the cost (after gating)
+  int heading_gated = 0;    // beyond the heading gate
+  int heading_skipped = 0;  // not finite, out of order, no state or IMU
   // The adaptive variance factors in use at the end, per light id.
   std::map<int, double> mono_variance_factor;
   std::map<int, double> stereo_variance_factor;
@@ -308,6 +316,8 @@ class SlidingWindowEstimator {
   void AddDvl(const DvlMeasurement& sample);
   // An acoustic fix, the same way (by its measurement time).
   void AddUsbl(const AcousticFix& fix);
+  // A heading sample (AHRS, compass), the same way.
+  void AddHeading(const HeadingMeasurement& sample);
   // An SBL range, the same way (by its ping's time).
   void AddSblRange(const SblRange& range);
 
@@ -353,6 +363,7 @@ class SlidingWindowEstimator {
   std::vector<SensorResidual> AttachDvl(int64_t t_ns);
   std::vector<SensorResidual> AttachUsbl(int64_t t_ns);
   std::vector<SensorResidual> AttachSbl(int64_t t_ns);
+  std::vector<SensorResidual> AttachHeading(int64_t t_ns);
   // The pending samples up to t_ns, each by add(sample, state) onto StateFor(its time,
   // max_before_s) (the factor, or nothing: then, as without a state, skipped with
   // kNoStateReason).
@@ -391,6 +402,7 @@ class SlidingWindowEstimator {
   std::deque<DvlMeasurement> pending_dvl_;
   std::deque<AcousticFix> pending_usbl_;
   std::deque<SblRange> pending_sbl_;
+  std::deque<HeadingMeasurement> pending_heading_;
   std::vector<Rejection> rejections_;  // not yet taken
   DvlRateTest dvl_rate_test_;
   AdaptiveNoiseScale dvl_noise_;  // the DVL's variance factor (adaptive_dvl_noise)
@@ -406,6 +418,7 @@ class SlidingWindowEstimator {
   int64_t last_depth_sample_t_ns_ = INT64_MIN;  // of the newest sample taken
   int64_t last_dvl_sample_t_ns_ = INT64_MIN;
   int64_t last_usbl_sample_t_ns_ = INT64_MIN;
+  int64_t last_heading_sample_t_ns_ = INT64_MIN;
   int64_t last_sbl_sample_t_ns_ = INT64_MIN;  // and its transducer: (time, transducer) increase
   int last_sbl_transducer_ = -1;
   int64_t last_frame_t_ns_ = INT64_MIN;

@@ -38,6 +38,10 @@ struct DockModel {
   Eigen::Vector3d gravity_D = Eigen::Vector3d(0.0, 0.0, 9.81);
   // Water depth (m, below the surface) of the D origin; the pressure sensor measures depth.
   double origin_depth_m = 30.0;
+  // The heading of D's x axis (its horizontal part), as a heading sensor would give it
+  // (HeadingMeasurement: clockwise from the heading reference seen from above), when surveyed;
+  // a heading factor needs it. dock.yaml: heading_deg.
+  double heading_rad = 0.0;
   // Acoustic (USBL/SBL) beacon / transponder position on the platform.
   Eigen::Vector3d p_D_beacon = Eigen::Vector3d::Zero();
   // Where vehicles come from, seen from the dock (any length, D frame; e.g. (-1, 0, -1): from

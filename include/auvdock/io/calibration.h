@@ -36,6 +36,16 @@ struct DepthCalibration {
   double sigma_m = 0.02;
 };
 
+// An AHRS or compass (HeadingMeasurement): its heading of the x axis of S (T_B_S's rotation;
+// its position does not matter), with 1-sigma sigma_rad. The dock's own heading in the same
+// reference is dock.yaml's heading_deg.
+struct HeadingCalibration {
+  std::string name = "ahrs0";
+  Pose3 T_B_S;
+  double rate_hz = 10.0;
+  double sigma_rad = 0.035;  // 2 degrees: a magnetic heading near a steel dock
+};
+
 struct DvlCalibration {
   std::string name = "dvl0";
   Pose3 T_B_S;
@@ -67,6 +77,7 @@ struct Calibration {
   std::optional<ImuCalibration> imu;
   std::optional<DepthCalibration> depth;
   std::optional<DvlCalibration> dvl;
+  std::optional<HeadingCalibration> heading;
   std::optional<AcousticCalibration> acoustic;
   std::optional<SblCalibration> sbl;
 

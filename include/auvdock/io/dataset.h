@@ -26,6 +26,7 @@ struct Dataset {
   std::vector<ImuSample> imu;
   std::vector<DepthMeasurement> depth;
   std::vector<DvlMeasurement> dvl;
+  std::vector<HeadingMeasurement> heading;  // calibration.heading (an AHRS or compass)
   std::vector<AcousticFix> acoustic;
   std::vector<SblRange> sbl;  // SBL ranges (calibration.sbl)
   std::map<std::string, std::vector<CameraFrame>> camera_frames;  // by camera name; absolute paths

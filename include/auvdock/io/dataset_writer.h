@@ -28,6 +28,7 @@ class DatasetWriter {
   void AddImu(const ImuSample& s);
   void AddDepth(const DepthMeasurement& m);
   void AddDvl(const DvlMeasurement& m);
+  void AddHeading(const HeadingMeasurement& m);
   void AddAcoustic(const AcousticFix& m);
   void AddSbl(const SblRange& m);
   // Writes <camera>/data/<t_ns>.png (lossless, 8-bit) and its data.csv row.
@@ -54,7 +55,7 @@ class DatasetWriter {
 
  private:
   std::string root_;
-  std::unique_ptr<CsvWriter> imu_, depth_, dvl_, acoustic_, sbl_, groundtruth_, visibility_, faults_;
+  std::unique_ptr<CsvWriter> imu_, depth_, dvl_, heading_, acoustic_, sbl_, groundtruth_, visibility_, faults_;
   std::unique_ptr<TumWriter> tum_;
   std::map<std::string, std::unique_ptr<CsvWriter>> cameras_;
   std::map<std::string, std::unique_ptr<CsvWriter>> rendered_lights_;

@@ -35,6 +35,14 @@ struct DepthMeasurement {
   double depth_m = 0.0;
 };
 
+// An AHRS's or compass's heading of its x axis: the angle about the downward vertical, clockwise
+// seen from above, from the heading reference (north, magnetic or true) to the axis's horizontal
+// part (rad, any branch).
+struct HeadingMeasurement {
+  int64_t t_ns = 0;
+  double heading_rad = 0.0;
+};
+
 struct DvlMeasurement {
   int64_t t_ns = 0;
   Eigen::Vector3d v_S = Eigen::Vector3d::Zero();

@@ -18,6 +18,7 @@ extern const char kImuCsvHeader[];
 extern const char kCameraCsvHeader[];
 extern const char kDepthCsvHeader[];
 extern const char kDvlCsvHeader[];
+extern const char kHeadingCsvHeader[];
 extern const char kAcousticCsvHeader[];
 extern const char kSblCsvHeader[];
 extern const char kGroundTruthCsvHeader[];
@@ -39,6 +40,8 @@ std::vector<DepthMeasurement> ReadDepthCsv(const std::string& path,
                                            std::vector<std::string>* skipped = nullptr);
 std::vector<DvlMeasurement> ReadDvlCsv(const std::string& path,
                                        std::vector<std::string>* skipped = nullptr);
+std::vector<HeadingMeasurement> ReadHeadingCsv(const std::string& path,
+                                               std::vector<std::string>* skipped = nullptr);
 std::vector<AcousticFix> ReadAcousticCsv(const std::string& path,
                                          std::vector<std::string>* skipped = nullptr);
 // SBL ranges, one row per transducer and ping: rows in strictly increasing (timestamp,
@@ -53,6 +56,7 @@ std::vector<FaultRecord> ReadFaultsCsv(const std::string& path);
 std::string ImuCsvRow(const ImuSample& s);
 std::string DepthCsvRow(const DepthMeasurement& m);
 std::string DvlCsvRow(const DvlMeasurement& m);
+std::string HeadingCsvRow(const HeadingMeasurement& m);
 std::string AcousticCsvRow(const AcousticFix& m);
 std::string SblCsvRow(const SblRange& m);
 std::string GroundTruthCsvRow(const GroundTruthState& s);

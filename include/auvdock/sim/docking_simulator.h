@@ -31,6 +31,7 @@ struct SimulationSummary {
   int n_depth = 0;
   int n_dvl = 0;
   int n_acoustic = 0;
+  int n_heading = 0;
   int n_sbl_ranges = 0;
   int n_faults = 0;
   double max_speed_mps = 0.0;

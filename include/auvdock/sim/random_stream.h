@@ -20,6 +20,7 @@ enum class RandomStreamId : uint64_t {
   kDvl = 3,
   kAcoustic = 4,
   kSbl = 5,
+  kHeading = 6,
   kLensBase = 50,         // + camera index: the randomised distortion
   kRenderLookBase = 200,  // + camera index: the randomised look
   kSyntheticDetectionsBase = 300,  // + camera index: the synthetic front-end's errors

@@ -67,6 +67,9 @@ struct Scenario {
   DvlFaultConfig dvl_faults;
   AcousticCalibration acoustic;
   AcousticFaultConfig acoustic_faults;
+  // An AHRS or compass (scenario key `heading:` {rate_hz, sigma_deg, yaw_deg: its x axis's turn
+  // from the body's about z}), absent unless the scenario has one (sim/heading_simulator.h).
+  std::optional<HeadingCalibration> heading;
   // A short-baseline array (scenario key `sbl:`), absent unless the scenario has one.
   std::optional<SblCalibration> sbl;
   SblFaultConfig sbl_faults;
