@@ -18,8 +18,8 @@
 //
 // Each new frame: preintegrate the IMU since the previous state, predict the new state, add the
 // factors, solve (Levenberg-Marquardt, iteration and time budget), gate vision residuals whose
-// Mahalanobis distance exceeds the chi-square gate and re-solve without them (from the warm
-// start, not from the solution the outliers pulled), then marginalize
+// Mahalanobis distance exceeds the chi-square gate and re-solve without them (to convergence
+// within the iteration budget: the outliers' pull can be long to undo), then marginalize
 // the oldest state into the prior when the window is full (estimator/marginalization.h), and
 // report the newest pose's marginal covariance (estimator/marginal_covariance.h).
 // Without vision the window carries on on the IMU alone; the covariance grows accordingly.
@@ -352,10 +352,8 @@ class SlidingWindowEstimator {
   void StartWindow(const InitialState& initial);
   void Reset(const std::string& reason);
   bool AddState(int64_t t_ns);
-  bool Solve();
-  // The window's states (pose, velocity, bias of each, oldest first), and back.
-  std::vector<double> SaveWindow() const;
-  void RestoreWindow(const std::vector<double>& values);
+  // stop_early: stop once a step lowers the cost by less than solver_cost_tolerance.
+  bool Solve(bool stop_early = true);
   void MarginalizeOldest();
   // The pending depth samples up to t_ns onto the states at or before them; returns the
   // residuals added.
