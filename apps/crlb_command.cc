@@ -85,8 +85,8 @@ void Crlb(const CrlbOptions& options) {
     }
   }
   if (!options.quiet) std::fprintf(stderr, "\n");
-  NavigationSamples sensors{dataset.depth, dataset.dvl, 1.0, 1.0, dataset.acoustic, dataset.sbl};
-  sensors.heading = dataset.heading;
+  const NavigationSamples sensors{dataset.depth, dataset.dvl, 1.0, 1.0, dataset.acoustic,
+                                  dataset.sbl, 1.0, dataset.heading};
   const CramerRaoBound bound = ComputeCramerRaoBound(dataset.calibration, dock, frames, dataset.imu,
                                                      dataset.groundtruth, config.estimator, sensors);
   cancel.ThrowIfCancelled();

@@ -86,10 +86,9 @@ void Smooth(const SmoothOptions& options) {
     };
   }
   const auto t0 = Clock::now();
-  NavigationSamples sensors{dataset.depth, dataset.dvl, estimator.stats().dvl_variance_factor,
+  const NavigationSamples sensors{dataset.depth, dataset.dvl, estimator.stats().dvl_variance_factor,
                             estimator.stats().depth_variance_factor, dataset.acoustic,
-                            dataset.sbl, estimator.stats().sbl_variance_factor};
-  sensors.heading = dataset.heading;
+                            dataset.sbl, estimator.stats().sbl_variance_factor, dataset.heading};
   const BatchResult result =
       SmoothBatch(dataset.calibration, *dataset.dock, frames, dataset.imu, estimator.History(),
                   config.estimator, batch, sensors);

@@ -116,13 +116,6 @@ void AcousticInitializer::AddDvl(const DvlMeasurement& sample) {
   dvl_.push_back(sample);
 }
 
-void AcousticInitializer::Clear() {
-  fixes_.clear();
-  dvl_.clear();
-  headings_.clear();
-  has_new_data_ = false;
-}
-
 std::optional<InitialState> AcousticInitializer::Solve(const ImuBuffer& imu, int64_t t_ns,
                                                        std::string* why) {
   has_new_data_ = false;
@@ -220,6 +213,7 @@ std::optional<InitialState> AcousticInitializer::Solve(const ImuBuffer& imu, int
   Fit fit;
   int kept = n_on_path;
   double chi2_sum = 0.0;
+  double worst_chi2 = 0.0;  // of the final fit
   while (true) {
     if (measured_psi) {
       fit = FitHeading(on_path, g, p_B_transponder_, *measured_psi, &bodies);
@@ -231,7 +225,7 @@ std::optional<InitialState> AcousticInitializer::Solve(const ImuBuffer& imu, int
     const Eigen::Matrix3d R = AboutGravity(g, fit.psi);
     const Eigen::Vector3d c = fit.b_bar - R * fit.d_bar;
     int worst = -1;
-    double worst_chi2 = 0.0;
+    worst_chi2 = 0.0;
     chi2_sum = 0.0;
     for (int i = 0; i < n_on_path; ++i) {
       if (!on_path[i].kept) continue;
@@ -246,10 +240,6 @@ std::optional<InitialState> AcousticInitializer::Solve(const ImuBuffer& imu, int
     on_path[worst].kept = false;
     --kept;
   }
-  if (kept < needed) {
-    return fail(std::to_string(kept) + " fixes agree with the DVL's path, " +
-                std::to_string(needed) + " needed");
-  }
   if (!measured_psi && !(fit.lever_information > 0.0)) return fail("the vehicle has not moved");
   const double fit_heading_sigma =
       measured_psi ? heading_sensor_->sigma_rad : 1.0 / std::sqrt(fit.lever_information);
@@ -260,18 +250,8 @@ std::optional<InitialState> AcousticInitializer::Solve(const ImuBuffer& imu, int
                   fit_heading_sigma * 180.0 / M_PI, options_.max_heading_sigma_rad * 180.0 / M_PI);
     return fail(text);
   }
-  // Beyond the gate after dropping to min_fixes: the fixes and the DVL disagree.
-  {
-    const Eigen::Matrix3d R = AboutGravity(g, fit.psi);
-    const Eigen::Vector3d c = fit.b_bar - R * fit.d_bar;
-    for (int i = 0; i < n_on_path; ++i) {
-      if (on_path[i].kept &&
-          (bodies[i] - c - R * on_path[i].d_W).squaredNorm() * on_path[i].weight >
-              options_.gate_chi2) {
-        return fail("the fixes and the DVL's path disagree");
-      }
-    }
-  }
+  // Still beyond the gate with only the fixes needed left: the fixes and the DVL disagree.
+  if (worst_chi2 > options_.gate_chi2) return fail("the fixes and the DVL's path disagree");
 
   // The state at t_ns.
   const size_t last = dvl_.size() - 1;

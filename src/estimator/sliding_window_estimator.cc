@@ -158,8 +158,7 @@ void SlidingWindowEstimator::AddImu(const ImuSample& sample) {
                       : window_.front()->t_ns -
                             static_cast<int64_t>(options_.usbl_max_backward_shift_s * kNsPerSecond);
   // Before initialisation the acoustic start traces the path over its span.
-  const double history_s =
-      options_.acoustic_init.enabled ? std::max(1.0, acoustic_init_.imu_history_s()) : 1.0;
+  const double history_s = options_.acoustic_init.enabled ? acoustic_init_.imu_history_s() : 1.0;
   imu_.DropBefore(window_.empty()
                       ? sample.t_ns - static_cast<int64_t>(history_s * kNsPerSecond)
                       : std::min({window_.front()->t_ns, rate_test_ns, late_fix_ns}));

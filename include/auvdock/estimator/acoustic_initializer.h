@@ -102,7 +102,6 @@ class AcousticInitializer {
   void AddFix(const AcousticFix& fix);
   void AddDvl(const DvlMeasurement& sample);
   void AddHeading(const HeadingMeasurement& sample);  // ignored without the heading sensor
-  void Clear();
 
   // True when a fix came since the last Solve (the caller tries again with each new fix).
   bool has_new_data() const { return has_new_data_; }
