@@ -21,6 +21,19 @@ double PyramidBlur(int level) {
   return std::sqrt(variance);
 }
 
+// v = row[x] is not below any of its 8 neighbours in the image (above, below: the rows around
+// it, nullptr at the image's edge).
+bool NotBelowNeighbours(float v, const float* above, const float* row, const float* below, int x,
+                        int cols) {
+  const int x0 = std::max(0, x - 1), x1 = std::min(cols - 1, x + 1);
+  for (int i = x0; i <= x1; ++i) {
+    if ((above != nullptr && v < above[i]) || v < row[i] || (below != nullptr && v < below[i])) {
+      return false;
+    }
+  }
+  return true;
+}
+
 void CheckOptions(const BlobCandidateOptions& o) {
   if (!(o.min_sigma_px > 0.3) || !(o.max_sigma_px >= o.min_sigma_px) || o.num_scales < 1 ||
       o.num_scales > 32 || !(o.min_response >= 0.0) || !(o.nms_radius_sigmas >= 0.0) ||
@@ -109,23 +122,22 @@ std::vector<BlobCandidate> FindBlobCandidates(const cv::Mat& luma,
            ay * ((1 - ax) * r.at<float>(y1, x0) + ax * r.at<float>(y1, x1));
   };
 
-  // Maxima over the 3 x 3 neighbourhood on the scale's own grid, then not below the neighbouring
-  // scales at the same point (sampled on their grids).
+  // Maxima over the 3 x 3 neighbourhood on the scale's own grid (neighbours outside the image do
+  // not count), then not below the neighbouring scales at the same point (sampled on their
+  // grids). Only points above the threshold are compared: most of an image is far below it.
   std::vector<BlobCandidate> found;
   const float threshold = static_cast<float>(options.min_response);
-  const cv::Mat kernel = cv::Mat::ones(3, 3, CV_8U);
-  cv::Mat spatial_max;
   const int last_scale = n > 1 && !options.keep_largest_scale ? n - 2 : n - 1;
   for (int k = 0; k <= last_scale; ++k) {
     const cv::Mat& r = responses[k];
-    cv::dilate(r, spatial_max, kernel);
     const int pixel = 1 << levels[k];
     for (int y = 0; y < r.rows; ++y) {
       const float* row = r.ptr<float>(y);
-      const float* own = spatial_max.ptr<float>(y);
+      const float* above = y > 0 ? r.ptr<float>(y - 1) : nullptr;
+      const float* below = y + 1 < r.rows ? r.ptr<float>(y + 1) : nullptr;
       for (int x = 0; x < r.cols; ++x) {
         const float v = row[x];
-        if (v < threshold || v < own[x]) continue;
+        if (v < threshold || !NotBelowNeighbours(v, above, row, below, x, r.cols)) continue;
         const int fx = std::min(x * pixel, level0.cols - 1);
         const int fy = std::min(y * pixel, level0.rows - 1);
         if (k > 0 && v < sample(k - 1, fx, fy)) continue;
