@@ -26,7 +26,8 @@ struct HeapSettings {
 };
 
 // Applies the settings to the process's allocator (glibc's mallopt). Returns false where that is
-// not possible (another C library, or glibc refused a value); the program works either way.
+// not possible (another C library, a sanitizer's allocator, or glibc refused a value); the program
+// works either way.
 bool ApplyHeapSettings(const HeapSettings& settings = {});
 
 }  // namespace auvdock::cli
