@@ -34,6 +34,7 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                             {"gated", stats.dvl_gated},
                             {"no_bottom_lock", stats.dvl_no_lock},
                             {"rate_test_rejected", stats.dvl_rate_rejected},
+                            {"not_admitted", stats.dvl_not_admitted},
                             {"skipped", stats.dvl_skipped}};
   summary["usbl_fixes"] = {{"used", stats.usbl_used},
                            {"gated", stats.usbl_gated},

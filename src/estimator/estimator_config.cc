@@ -42,6 +42,8 @@ RunConfig LoadRunConfig(const std::string& path) {
       est.GetPositive("dvl_rate_accel_sigma_mps2", e.dvl_rate_test.accel_sigma_mps2);
   e.dvl_rate_test.max_reference_age_s =
       est.GetPositive("dvl_rate_max_reference_age_s", e.dvl_rate_test.max_reference_age_s);
+  e.dvl_admission = est.GetBool("dvl_admission", e.dvl_admission);
+  e.dvl_admission_bias_mps = est.GetPositive("dvl_admission_bias_mps", e.dvl_admission_bias_mps);
   e.use_heading = est.GetBool("use_heading", e.use_heading);
   e.heading_gate_chi2 = est.GetNonNegative("heading_gate_chi2", e.heading_gate_chi2);
   e.acoustic_init.enabled = est.GetBool("acoustic_init", e.acoustic_init.enabled);

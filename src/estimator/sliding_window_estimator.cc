@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include <Eigen/Eigenvalues>
 #include <ceres/iteration_callback.h>
 #include <ceres/problem.h>
 #include <ceres/solver.h>
@@ -127,6 +128,8 @@ void SlidingWindowEstimator::Reset(const std::string& reason) {
     }
   }
   dvl_rate_test_.Reset();
+  dvl_admitted_ = false;
+  newest_pose_velocity_covariance_.reset();
   sbl_transducer_of_.clear();
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -233,6 +236,7 @@ bool SlidingWindowEstimator::InitializeAcoustically(int64_t t_ns) {
   pending_dvl_.erase(std::remove_if(pending_dvl_.begin(), pending_dvl_.end(), before),
                      pending_dvl_.end());
   StartWindow(*initial);
+  dvl_admitted_ = true;  // the start's fit checked the DVL's path against the fixes
   return true;
 }
 
@@ -530,6 +534,18 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
       id = AddDvlFactor(problem_.get(), sample, *calibration_.dvl, dock_, BlocksOf(*state),
                         state->t_ns, shift, dvl_noise_.factor(), options_.sensor_huber_sigmas);
     }
+    if (id && !dvl_admitted_) {
+      std::string reason;
+      const double statistic = DvlAdmissionStatistic(*id, &reason);
+      if (!reason.empty() || statistic > options_.dvl_gate_chi2) {
+        problem_->RemoveResidualBlock(*id);
+        ++stats_.dvl_not_admitted;
+        rejections_.push_back({sample.t_ns, name, reason.empty() ? statistic : kNoStatistic,
+                               reason.empty() ? std::string(kDvlNotAdmittedReason) : reason});
+        return;
+      }
+      dvl_admitted_ = true;
+    }
     if (id) {
       added.push_back({*id, sample.t_ns});
     } else {
@@ -618,7 +634,55 @@ std::optional<Eigen::MatrixXd> SlidingWindowEstimator::PoseCovariance(const Stat
     *reason = "rank-deficient information (an unobserved direction)";
     return std::nullopt;
   }
+  newest_pose_velocity_covariance_ =
+      last->covariance->topLeftCorner(kPoseTangentSize + kVelocitySize,
+                                      kPoseTangentSize + kVelocitySize);
   return last->covariance->topLeftCorner(kPoseTangentSize, kPoseTangentSize).eval();
+}
+
+double SlidingWindowEstimator::DvlAdmissionStatistic(ceres::ResidualBlockId id,
+                                                     std::string* reason) {
+  if (!options_.dvl_admission || !options_.compute_covariance) return 0.0;
+  if (!newest_pose_velocity_covariance_) {
+    *reason = kDvlUntestableReason;
+    return kNoStatistic;
+  }
+  std::vector<double*> blocks;
+  problem_->GetParameterBlocksForResidualBlock(id, &blocks);
+  // The residual's Jacobian on its state's pose (tangent) and velocity, with the newest state's
+  // marginal after the last solve (a sample on an older state, a late one, the same).
+  Eigen::Vector3d residual = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>> J(blocks.size());
+  std::vector<double*> jacobians(blocks.size());
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    J[b].resize(3, problem_->ParameterBlockTangentSize(blocks[b]));
+    jacobians[b] = J[b].data();
+  }
+  double cost = 0.0;
+  if (!problem_->EvaluateResidualBlock(id, /*apply_loss_function=*/false, &cost, residual.data(),
+                                       jacobians.data())) {
+    *reason = kDvlUntestableReason;
+    return kNoStatistic;
+  }
+  Eigen::Matrix<double, 3, kPoseTangentSize + kVelocitySize> H =
+      Eigen::Matrix<double, 3, kPoseTangentSize + kVelocitySize>::Zero();
+  for (size_t b = 0; b < blocks.size(); ++b) {
+    if (problem_->ParameterBlockSize(blocks[b]) == kPoseSize) {
+      H.leftCols<kPoseTangentSize>() += J[b];
+    } else if (problem_->ParameterBlockSize(blocks[b]) == kVelocitySize) {
+      H.rightCols<kVelocitySize>() += J[b];
+    }
+  }
+  const Eigen::Matrix3d S =
+      Eigen::Matrix3d::Identity() + H * *newest_pose_velocity_covariance_ * H.transpose();
+  const double sigma = calibration_.dvl->sigma_mps * std::sqrt(dvl_noise_.factor());
+  const double bias_whitened = options_.dvl_admission_bias_mps / sigma;
+  const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(S).eigenvalues().maxCoeff();
+  if (largest * options_.dvl_gate_chi2 > bias_whitened * bias_whitened) {
+    *reason = kDvlUntestableReason;
+    return kNoStatistic;
+  }
+  return residual.dot(S.ldlt().solve(residual));
 }
 
 EstimatorOutput SlidingWindowEstimator::Output(const State& state) {

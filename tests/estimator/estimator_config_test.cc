@@ -47,6 +47,25 @@ TEST(EstimatorConfigTest, AcousticStartKeys) {
   }
 }
 
+TEST(EstimatorConfigTest, DvlAdmissionKeys) {
+  const test::TempDir dir;
+  const std::string path = dir.path() + "/estimator.yaml";
+  EXPECT_TRUE(EstimatorOptions().dvl_admission);
+  {
+    std::ofstream(path) << "estimator:\n  dvl_admission: false\n  dvl_admission_bias_mps: 0.3\n";
+  }
+  const RunConfig config = LoadRunConfig(path);
+  EXPECT_FALSE(config.estimator.dvl_admission);
+  EXPECT_EQ(config.estimator.dvl_admission_bias_mps, 0.3);
+  { std::ofstream(path) << "estimator:\n  dvl_admission_bias_mps: -0.2\n"; }
+  try {
+    LoadRunConfig(path);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("dvl_admission_bias_mps"), std::string::npos) << e.what();
+  }
+}
+
 TEST(EstimatorConfigTest, AdaptiveDvlNoiseSwitch) {
   const test::TempDir dir;
   const std::string path = dir.path() + "/estimator.yaml";

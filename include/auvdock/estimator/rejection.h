@@ -26,6 +26,12 @@ inline constexpr const char* kNoStateReason =
 // ... of a DVL sample the rate test held (dvl_rate_test.h) that no later sample came to test.
 inline constexpr const char* kHeldDvlExpiredReason =
     "rate test: held, and no sample within the reference age came to test it against";
+// ... of a DVL sample before the DVL's admission (EstimatorOptions::dvl_admission) that
+// disagreed with the window's velocity, and of one the window could not test yet.
+inline constexpr const char* kDvlNotAdmittedReason =
+    "before admission: disagrees with the window's velocity without it";
+inline constexpr const char* kDvlUntestableReason =
+    "before admission: the window's velocity cannot test it yet";
 inline constexpr const char* kBeforeFirstStateReason =
     "before the estimator's first state (it initialised after this sample)";
 
