@@ -63,7 +63,8 @@ def tally(dataset, outdir, faults, rejected, clean, clean_rejected, clean_unused
                 clean_unused[sensor] += t in unused_at[sensor] and t not in rejected_at[sensor]
             else:
                 faults[(sensor, kind)] += 1
-                rejected[(sensor, kind)] += t in rejected_at[sensor]
+                # A fault left out before it could be judged did not get in either.
+                rejected[(sensor, kind)] += t in rejected_at[sensor] or t in unused_at[sensor]
 
 
 def main(argv):
