@@ -642,7 +642,10 @@ std::optional<Eigen::MatrixXd> SlidingWindowEstimator::PoseCovariance(const Stat
 
 double SlidingWindowEstimator::DvlAdmissionStatistic(ceres::ResidualBlockId id,
                                                      std::string* reason) {
-  if (!options_.dvl_admission || !options_.compute_covariance) return 0.0;
+  // Off, no covariance to test with, or no DVL gate (dvl_gate_chi2 0): admitted at once.
+  if (!options_.dvl_admission || !options_.compute_covariance || !(options_.dvl_gate_chi2 > 0.0)) {
+    return 0.0;
+  }
   if (!newest_pose_velocity_covariance_) {
     *reason = kDvlUntestableReason;
     return kNoStatistic;

@@ -233,7 +233,9 @@ struct EstimatorOptions {
   // (lambda_max(S) <= (bias / sigma)^2 / gate); until then it is left out, with that reason.
   // The first sample that passes admits the DVL (the rate test and the gate then take over);
   // one that fails is rejected. An acoustic start admits it at once (the fit checked the DVL's
-  // path against the fixes). Needs compute_covariance (without it the DVL is admitted at once).
+  // path against the fixes). Needs compute_covariance and the DVL gate (without either the DVL
+  // is admitted at once). A DVL that the window never learns to test (no lights and no acoustic
+  // start) stays out, every sample with that reason in rejections.csv.
   bool dvl_admission = true;
   double dvl_admission_bias_mps = 0.2;  // seed 003's gross-error level
   // The start without lights from acoustic fixes, the DVL and the IMU (acoustic_initializer.h;
