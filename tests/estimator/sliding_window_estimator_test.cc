@@ -852,6 +852,21 @@ TEST(SlidingWindowEstimatorTest, ADvlBiasedFromTheStartIsNotAdmitted) {
   RecordProperty("max_position_error_mm_without", static_cast<int>(1e3 * max_error[1]));
 }
 
+// Without a DVL gate (dvl_gate_chi2 0: no gate) there is no admission test either: the DVL is
+// used from its first sample, as before the admission existed.
+TEST(SlidingWindowEstimatorTest, WithoutADvlGateTheDvlIsAdmittedAtOnce) {
+  Scenario scenario = test::DefaultScenario();
+  scenario.duration_s = 4.0;
+  scenario.dvl_faults.gross_error_probability = 0.0;
+  const test::SyntheticRun run = test::MakeSyntheticRun(scenario, 5);
+  EstimatorOptions options;
+  options.dvl_gate_chi2 = 0.0;
+  SlidingWindowEstimator estimator(run.calibration, run.dock, options);
+  RunEstimator(run, &estimator, 1.0, true, true);
+  EXPECT_EQ(estimator.stats().dvl_not_admitted, 0);
+  EXPECT_GT(estimator.stats().dvl_used, 0);
+}
+
 // Bad sensor input is rejected with a reason, never used: a depth above the surface, a DVL that
 // holds its reading (exactly zero for the rest of the run), samples that run backwards after
 // earlier ones were already used.
