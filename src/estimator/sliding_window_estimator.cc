@@ -540,7 +540,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
       if (!reason.empty() || statistic > options_.dvl_gate_chi2) {
         problem_->RemoveResidualBlock(*id);
         ++stats_.dvl_not_admitted;
-        rejections_.push_back({sample.t_ns, name, reason.empty() ? statistic : kNoStatistic,
+        rejections_.push_back({sample.t_ns, name, statistic,  // NaN when untestable
                                reason.empty() ? std::string(kDvlNotAdmittedReason) : reason});
         return;
       }
