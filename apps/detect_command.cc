@@ -17,6 +17,10 @@
 //   OUTDIR/frames.csv      frame,image,detections,identified,status,tracked,rms_px,sigma_px,
 //                          tx,ty,tz,qx,qy,qz,qw (T_C_D, empty without a pose),symmetry,reason
 //   OUTDIR/camera_poses.tum  T_D_C per frame with a pose, time = frame / rate_hz of the camera
+//   OUTDIR/camera_pose_covariance.csv  the covariance of each of those poses, in run's
+//                          covariance.csv format (io/pose_covariance_csv.h: timestamp_ns =
+//                          frame / rate_hz, tangent [dp_D, dtheta_D] of T_D_C), from each light's
+//                          own centroid covariance and the fit's variance factor (SolvePnp)
 //   OUTDIR/summary.json    counts, the reasons' counts, the rejected candidates' counts by kind,
 //                          time per frame, and with --labels the evaluation against the labels
 //                          (detection_evaluation.h)
@@ -28,6 +32,7 @@
 // the dock's lights have a colour, unreadable calibration, dock or labels): one line, exit 2.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -49,8 +54,10 @@
 #include "auvdock/io/dock_io.h"
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/light_labels_csv.h"
+#include "auvdock/io/pose_covariance_csv.h"
 #include "auvdock/io/staged_directory.h"
 #include "auvdock/vision/mono_light_pipeline.h"
+#include "auvdock/vision/pnp_solver.h"
 
 namespace fs = std::filesystem;
 
@@ -160,6 +167,8 @@ void RunDetect(const DetectOptions& options) {
   if (options.overlay) {
     rejected_csv = CsvWriter(options.out + "/rejected.csv", "frame,image,u,v,sigma,reason");
   }
+  CsvWriter pose_covariance_csv(options.out + "/camera_pose_covariance.csv",
+                                PoseCovarianceCsvHeader());
   std::ofstream poses(options.out + "/camera_poses.tum");
   poses << "# timestamp tx ty tz qx qy qz qw (T_D_C: the camera in the dock frame)\n";
 
@@ -233,6 +242,9 @@ void RunDetect(const DetectOptions& options) {
                     f / camera.rate_hz, T_D_C.p.x(), T_D_C.p.y(), T_D_C.p.z(), T_D_C.q.x(),
                     T_D_C.q.y(), T_D_C.q.z(), T_D_C.q.w());
       poses << line << std::flush;
+      pose_covariance_csv.Row(std::llround(1e9 * f / camera.rate_hz),
+                              PoseCovarianceCsvValues(CameraInDockCovariance(
+                                  *pose.T_C_D, pose.covariance_local)));
       ++n_pose;
       n_tracked += pose.tracked;
     } else {
@@ -352,7 +364,8 @@ void AddDetectCommand(CLI::App& root) {
   CLI::App* sub = root.add_subcommand(
       "detect",
       "Detect and identify the dock's lights in one's own images (mono pose per image); writes "
-      "detections.csv, frames.csv, camera_poses.tum, summary.json [, overlay/]");
+      "detections.csv, frames.csv, camera_poses.tum, camera_pose_covariance.csv, summary.json "
+      "[, overlay/]");
   sub->footer(DetectHelp());
   sub->add_option("--images", options->images, "Image files, a glob pattern: \"DIR/*.jpg\"")
       ->required();

@@ -105,8 +105,10 @@ std::string EvaluateHelp() {
 
 std::string PnpHelp() {
   return "\nNeeds: a calibration and a CSV of correspondences (header X,Y,Z,u,v: model metres,\n"
-         "raw distorted pixels). Prints one JSON object: R, t, rvec, the 6x6 covariance\n"
-         "(rvec then t), rms_px, n_points, iterations (x_cam = R X + t).\n"
+         "raw distorted pixels; add cov_uu,cov_uv,cov_vv for each pixel's own covariance).\n"
+         "Prints one JSON object: R, t, rvec, the 6x6 covariance (rvec then t; widened by the\n"
+         "a-posteriori variance factor when the pixels fit worse than claimed), rms_px, chi2,\n"
+         "dof, variance_factor, n_points, iterations (x_cam = R X + t).\n"
          "Example: auvdock pnp --calib out/sim/calibration.yaml --camera cam2 --points pts.csv\n";
 }
 

@@ -123,8 +123,12 @@ MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detectio
     return result;
   }
 
+  // The pose weighs each light by its detection's own covariance (a light cut by the border
+  // counts for less), never below the camera's pixel noise; its covariance grows by the
+  // a-posteriori variance factor when the lights fit worse than they claim (SolvePnp step 3).
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Matrix2d> covariances;
   std::vector<int> ids(detections.size(), -1);
   for (const LightMatch& m : match.matches) {
     const DockLight* light = dock_.FindLight(m.light_id);
@@ -132,10 +136,12 @@ MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detectio
     ids[m.detection] = m.light_id;
     points.push_back(light->p_D);
     pixels.push_back(detections[m.detection].uv);
+    covariances.push_back(
+        PixelCovarianceAtLeast(detections[m.detection], camera_.pixel_noise_px));
   }
   PnpOptions pnp;
   pnp.pixel_sigma = sigma;
-  const PnpResult pose = SolvePnp(points, pixels, camera_.intrinsics, pnp, start);
+  const PnpResult pose = SolvePnp(points, pixels, camera_.intrinsics, pnp, start, covariances);
   if (!pose.ok) {
     result.status = MatchStatus::kFailed;
     result.reason = "pnp: " + pose.reason;
@@ -146,11 +152,7 @@ MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detectio
   result.rms_px = pose.rms_px;
   result.num_lights = static_cast<int>(points.size());
   result.covariance_local = pose.covariance_local;
-  const int dof = 2 * result.num_lights - 6;
-  if (dof > 0) {
-    const double s02 = pose.rms_px * pose.rms_px * result.num_lights / (sigma * sigma * dof);
-    if (s02 > 1.0) result.covariance_local *= s02;
-  }
+  result.variance_factor = pose.variance_factor;
   last_T_C_D_ = pose.T_C_D;
   frames_since_pose_ = 0;
   return result;

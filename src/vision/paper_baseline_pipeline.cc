@@ -231,13 +231,18 @@ void PaperBaselinePipeline::StereoPose(bool left_identified,
 
 void PaperBaselinePipeline::MonoPose(const std::optional<Pose3>& predicted_T_C_D,
                                      BaselineFrame* frame) {
+  // Each light weighed by its detection's own covariance (a detector that measures none: the
+  // camera's pixel noise), never below the camera's pixel noise.
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Matrix2d> covariances;
   for (std::size_t i = 0; i < frame->mono.detections.size(); ++i) {
     const int id = frame->mono.light_ids[i];
     if (id < 0) continue;
     points.push_back(dock_.FindLight(id)->p_D);
     pixels.push_back(frame->mono.detections[i].uv);
+    covariances.push_back(
+        PixelCovarianceAtLeast(frame->mono.detections[i], mono_->pixel_noise_px));
   }
   const int needed =
       frame->mono.tracked ? std::min(3, options_.min_mono_lights) : options_.min_mono_lights;
@@ -247,7 +252,8 @@ void PaperBaselinePipeline::MonoPose(const std::optional<Pose3>& predicted_T_C_D
   // The prediction, not the matcher's pose: of a planar target's two minima that fit the pixels
   // equally well the matcher keeps the lower cost, which is no evidence; only a pose known
   // independently of this image can choose (SolvePnp step 2b), else there is no mono pose.
-  const PnpResult result = SolvePnp(points, pixels, mono_->intrinsics, pnp, predicted_T_C_D);
+  const PnpResult result =
+      SolvePnp(points, pixels, mono_->intrinsics, pnp, predicted_T_C_D, covariances);
   if (!result.ok) {
     frame->reason = "mono: " + result.reason;
     return;

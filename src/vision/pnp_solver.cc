@@ -80,25 +80,34 @@ struct Problem {
   const std::vector<Eigen::Vector3d>& X;
   const std::vector<Eigen::Vector2d>& uv;
   const PinholeRadtanCamera& camera;
+  // W_i = L_i^-1 with Sigma_i = L_i L_i^T, the pixel's covariance: r_i = W_i (pi(...) - u_i) is
+  // whitened, so that 1/2 |r|^2 is half the chi-square of the pixels.
+  const std::vector<Eigen::Matrix2d>& whiten;
 };
 
-// Residuals r (2n, pixels) and J = dr / d(dtheta, dt) for the left perturbation. Returns false
-// (and leaves r, J unspecified) if a point is not in front of the camera.
-bool Evaluate(const Problem& problem, const Rigid& T, Eigen::VectorXd* r, Eigen::MatrixXd* J) {
+// Whitened residuals r (2n) and J = dr / d(dtheta, dt) for the left perturbation; the squared
+// pixel error sum_i |pi(...) - u_i|^2 in *pixel_squared_norm if given. Returns false (and leaves
+// r, J unspecified) if a point is not in front of the camera.
+bool Evaluate(const Problem& problem, const Rigid& T, Eigen::VectorXd* r, Eigen::MatrixXd* J,
+              double* pixel_squared_norm = nullptr) {
   const int n = static_cast<int>(problem.X.size());
   r->resize(2 * n);
   if (J != nullptr) J->resize(2 * n, 6);
+  if (pixel_squared_norm != nullptr) *pixel_squared_norm = 0.0;
   bool in_front = true;
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d RX = T.R * problem.X[i];
     const Eigen::Vector3d p = RX + T.t;
     if (!(p.z() > 0.0)) in_front = false;
     Eigen::Matrix<double, 2, 3> J_uv_p;
-    r->segment<2>(2 * i) =
+    const Eigen::Vector2d error =
         ProjectWithJacobian(problem.camera, p, J != nullptr ? &J_uv_p : nullptr) - problem.uv[i];
+    if (pixel_squared_norm != nullptr) *pixel_squared_norm += error.squaredNorm();
+    const Eigen::Matrix2d& W = problem.whiten[i];
+    r->segment<2>(2 * i) = W * error;
     if (J != nullptr) {
-      J->block<2, 3>(2 * i, 0) = -J_uv_p * Hat(RX);
-      J->block<2, 3>(2 * i, 3) = J_uv_p;
+      J->block<2, 3>(2 * i, 0) = -W * J_uv_p * Hat(RX);
+      J->block<2, 3>(2 * i, 3) = W * J_uv_p;
     }
   }
   return in_front && r->allFinite();
@@ -108,7 +117,7 @@ struct Refined {
   Rigid T;
   bool converged = false;
   bool in_front = false;
-  double cost = std::numeric_limits<double>::infinity();  // 1/2 sum |r|^2
+  double cost = std::numeric_limits<double>::infinity();  // 1/2 sum |r|^2, r whitened
   int iterations = 0;
 };
 
@@ -545,10 +554,20 @@ Eigen::Matrix3d LeftJacobianInverse(const Eigen::Vector3d& w) {
 
 }  // namespace
 
+Matrix6d CameraInDockCovariance(const Pose3& T_C_D, const Matrix6d& covariance_local) {
+  const Eigen::Matrix3d R_D_C = T_C_D.R().transpose();
+  Matrix6d J = Matrix6d::Zero();  // d(dp_D, dtheta_D) / d(dtheta, dt)
+  J.block<3, 3>(0, 0) = -R_D_C * Hat(T_C_D.p);
+  J.block<3, 3>(0, 3) = -R_D_C;
+  J.block<3, 3>(3, 0) = -R_D_C;
+  return J * covariance_local * J.transpose();
+}
+
 PnpResult SolvePnp(const std::vector<Eigen::Vector3d>& points_D,
                    const std::vector<Eigen::Vector2d>& pixels_distorted,
                    const PinholeRadtanCamera& camera, const PnpOptions& options,
-                   const std::optional<Pose3>& initial_T_C_D) {
+                   const std::optional<Pose3>& initial_T_C_D,
+                   const std::vector<Eigen::Matrix2d>& pixel_covariances) {
   const size_t n = points_D.size();
   if (pixels_distorted.size() != n) return Fail("size mismatch between points and pixels");
   if (n < 3) return Fail("fewer than 3 correspondences");
@@ -563,6 +582,20 @@ PnpResult SolvePnp(const std::vector<Eigen::Vector3d>& points_D,
   if (initial_T_C_D.has_value() &&
       (!initial_T_C_D->q.coeffs().allFinite() || !initial_T_C_D->p.allFinite())) {
     return Fail("NaN or Inf in the initial pose");
+  }
+  if (!pixel_covariances.empty() && pixel_covariances.size() != n) {
+    return Fail("size mismatch between pixels and pixel covariances");
+  }
+  // Whitening W_i = L_i^-1 (Sigma_i = L_i L_i^T); pixel_sigma^2 I when no covariances are given.
+  std::vector<Eigen::Matrix2d> whiten(n, Eigen::Matrix2d::Identity() / options.pixel_sigma);
+  for (size_t i = 0; i < pixel_covariances.size(); ++i) {
+    const Eigen::Matrix2d& S = pixel_covariances[i];
+    const Eigen::LLT<Eigen::Matrix2d> llt(S);
+    if (!S.allFinite() || std::abs(S(0, 1) - S(1, 0)) > 1e-9 * S.norm() ||
+        llt.info() != Eigen::Success || !(llt.matrixLLT().diagonal().minCoeff() > 0.0)) {
+      return Fail("pixel covariance " + std::to_string(i) + " is not positive definite");
+    }
+    whiten[i] = llt.matrixL().solve(Eigen::Matrix2d::Identity());
   }
 
   // Shape of the model: centroid, principal axes (det +1) and RMS spreads.
@@ -612,7 +645,14 @@ PnpResult SolvePnp(const std::vector<Eigen::Vector3d>& points_D,
   }
   if (starts.empty()) return Fail("no closed-form start (degenerate image points)");
 
-  const Problem problem{points_D, pixels_distorted, camera};
+  const Problem problem{points_D, pixels_distorted, camera, whiten};
+  // Root mean square pixel error of a pose (unweighted), for the reasons and rms_px.
+  auto pixel_rms = [&](const Rigid& T) {
+    Eigen::VectorXd unused;
+    double squared = 0.0;
+    Evaluate(problem, T, &unused, nullptr, &squared);
+    return std::sqrt(squared / static_cast<double>(n));
+  };
   std::vector<Refined> minima;  // converged, every point in front
   bool any_in_front = false;
   for (const Rigid& start : starts) {
@@ -645,19 +685,18 @@ PnpResult SolvePnp(const std::vector<Eigen::Vector3d>& points_D,
   Evaluate(problem, lowest.T, &r, &J);
   Matrix6d A = J.transpose() * J;
   if (!(A.diagonal().minCoeff() > 0.0)) return Fail("singular normal equations");
-  const double variance = options.pixel_sigma * options.pixel_sigma;
 
   // Step 2b: a second minimum, distinct beyond the noise (Mahalanobis distance^2 from the lowest
-  // above ambiguity_chi2 in the lowest's covariance) whose squared error exceeds the lowest's by
-  // less than ambiguity_chi2 sigma^2, explains the pixels about as well.
+  // above ambiguity_chi2 in the lowest's covariance) whose chi-square exceeds the lowest's by
+  // less than ambiguity_chi2, explains the pixels about as well. (Costs and A are whitened.)
   const Refined* rival = nullptr;
   if (check_ambiguity) {
     for (std::size_t k = 1; k < minima.size() && rival == nullptr; ++k) {
       const Refined& other = minima[k];
-      if (2.0 * (other.cost - lowest.cost) / variance >= options.ambiguity_chi2) break;
+      if (2.0 * (other.cost - lowest.cost) >= options.ambiguity_chi2) break;
       Vector6d d;
       d << LogSO3(other.T.R * lowest.T.R.transpose()), other.T.t - lowest.T.t;
-      if (d.dot(A * d) / variance > options.ambiguity_chi2) rival = &other;
+      if (d.dot(A * d) > options.ambiguity_chi2) rival = &other;
     }
   }
   const Refined* chosen = &lowest;
@@ -665,8 +704,8 @@ PnpResult SolvePnp(const std::vector<Eigen::Vector3d>& points_D,
   if (rival != nullptr) {
     ambiguous_T_C_D = {Pose3(Eigen::Quaterniond(lowest.T.R), lowest.T.t),
                        Pose3(Eigen::Quaterniond(rival->T.R), rival->T.t)};
-    const double rms_lowest = std::sqrt(2.0 * lowest.cost / static_cast<double>(n));
-    const double rms_rival = std::sqrt(2.0 * rival->cost / static_cast<double>(n));
+    const double rms_lowest = pixel_rms(lowest.T);
+    const double rms_rival = pixel_rms(rival->T);
     const double apart = RotationAngleBetween(ambiguous_T_C_D[0].q, ambiguous_T_C_D[1].q);
     std::ostringstream reason;
     reason.precision(3);
@@ -713,12 +752,17 @@ PnpResult SolvePnp(const std::vector<Eigen::Vector3d>& points_D,
   result.ok = true;
   result.T_C_D = Pose3(Eigen::Quaterniond(best.T.R), best.T.t);
   result.ambiguous_T_C_D = ambiguous_T_C_D;
+  result.chi2 = 2.0 * best.cost;
+  result.dof = 2 * static_cast<int>(n) - 6;
+  result.variance_factor = result.dof > 0 ? result.chi2 / result.dof : 1.0;
+  const double inflation = options.inflate_by_variance_factor ? std::max(1.0, result.variance_factor)
+                                                              : 1.0;
   result.covariance_local =
-      variance * inv_scale.asDiagonal() * A_scaled_inverse * inv_scale.asDiagonal();
+      inflation * inv_scale.asDiagonal() * A_scaled_inverse * inv_scale.asDiagonal();
   Matrix6d G = Matrix6d::Identity();
   G.topLeftCorner<3, 3>() = LeftJacobianInverse(LogQuaternion(result.T_C_D.q));
   result.covariance = G * result.covariance_local * G.transpose();
-  result.rms_px = std::sqrt(2.0 * best.cost / static_cast<double>(n));
+  result.rms_px = pixel_rms(best.T);
   result.iterations = best.iterations;
   return result;
 }

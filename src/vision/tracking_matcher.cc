@@ -265,14 +265,45 @@ MatchResult MatchByPrediction(const std::vector<LightDetection>& detections, con
   for (size_t c = 1; c < candidates.size(); ++c) {
     if (Better(candidates[c], candidates[best_index])) best_index = c;
   }
-  const OffsetSupport& best_candidate = candidates[best_index];
-  if (best_candidate.count < options.min_matches) {
-    return Failed("only " + std::to_string(best_candidate.count) +
+  if (candidates[best_index].count < options.min_matches) {
+    return Failed("only " + std::to_string(candidates[best_index].count) +
                   " lights have a detection near their predicted position");
   }
+  // The mean offset of a candidate's labelling (detection minus projection over its support).
+  auto labelled_offset = [&](const OffsetSupport& c) {
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (size_t i = 0; i < lights.size(); ++i) {
+      const int j = c.detection_of_light[i];
+      if (j >= 0) sum += detections[j].uv - lights[i].uv;
+    }
+    return (sum / std::max(1, c.count)).norm();
+  };
+  // Among the labellings explaining the most lights, the one nearest the prediction: it wins when
+  // every other is decisive_offset_ratio times as far from it.
+  const int most = candidates[best_index].count;
+  const OffsetSupport* nearest = &candidates[best_index];
+  double nearest_px = labelled_offset(*nearest);
+  for (const OffsetSupport& c : candidates) {
+    if (c.count != most) continue;
+    const double px = labelled_offset(c);
+    if (px < nearest_px) {
+      nearest = &c;
+      nearest_px = px;
+    }
+  }
+  const double decisive_px =
+      options.decisive_offset_ratio * std::max(nearest_px, options.min_residual_gate_px);
+  bool decisive = options.decisive_offset_ratio > 0.0;
+  for (const OffsetSupport& other : candidates) {
+    if (other.count == most && other.detection_of_light != nearest->detection_of_light &&
+        !(labelled_offset(other) > decisive_px)) {
+      decisive = false;
+    }
+  }
+  const OffsetSupport& best_candidate = decisive ? *nearest : candidates[best_index];
   // Another offset explaining as many lights with a different labelling: refuse to choose.
   for (const OffsetSupport& other : candidates) {
-    if (other.count == best_candidate.count &&
+    if (!decisive && other.count == best_candidate.count &&
         other.detection_of_light != best_candidate.detection_of_light) {
       std::ostringstream reason;
       reason.precision(3);

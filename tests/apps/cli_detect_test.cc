@@ -18,6 +18,8 @@
 #include "auvdock/geometry/pose3.h"
 #include "auvdock/geometry/so3.h"
 #include "auvdock/io/dock_io.h"
+#include "auvdock/io/pose_covariance_csv.h"
+#include "auvdock/io/tum_io.h"
 #include "tests/testing/led_image.h"
 #include "tests/testing/run_command.h"
 #include "tests/testing/temp_dir.h"
@@ -102,11 +104,20 @@ TEST(DetectCli, PosesEveryFrameOfASymmetricRingWithConsistentIdentities) {
   const test::CommandResult r = test::RunAuvdock(DetectArgs(footage, out));
   ASSERT_EQ(r.exit_status, 0) << r.err;
   for (const char* file : {"detections.csv", "frames.csv", "camera_poses.tum", "summary.json",
-                           "rejected.csv", "overlay/f000.png"}) {
+                           "rejected.csv", "overlay/f000.png", "camera_pose_covariance.csv"}) {
     EXPECT_TRUE(std::filesystem::exists(out + "/" + file)) << file;
   }
   const nlohmann::json summary = nlohmann::json::parse(test::ReadTextFile(out + "/summary.json"));
   EXPECT_EQ(summary["frames_with_pose"], 12);
+  // A covariance for every pose, at its time (the reader checks symmetry and definiteness).
+  const Trajectory poses = ReadTumTrajectory(out + "/camera_poses.tum");
+  const std::vector<StampedPoseCovariance> covariances =
+      ReadPoseCovarianceCsv(out + "/camera_pose_covariance.csv");
+  ASSERT_EQ(poses.size(), 12u);
+  ASSERT_EQ(covariances.size(), poses.size());
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_NEAR(static_cast<double>(covariances[k].t_ns - poses[k].t_ns), 0.0, 1e3) << k;
+  }
   EXPECT_EQ(summary["labels"]["recall"], 1.0);
   EXPECT_EQ(summary["labels"]["precision"], 1.0);
   EXPECT_LT(summary["labels"]["centroid_rms_px"].get<double>(), 0.3);

@@ -89,6 +89,52 @@ TEST_F(PnpCli, BadInputIsOneLineAndExitTwo) {
                "distortion_coefficients");
 }
 
+TEST_F(PnpCli, PerPointCovariancesWeighThePixelsAndABadOneNamesItsLine) {
+  // Seven correspondences, the first pixel 4 px off. Claimed at 0.3 px it pulls the pose and
+  // the fit's variance factor widens the covariance; claimed at 20 px it hardly counts.
+  auto write = [&](double first_sigma, const std::string& extra) {
+    std::string text = "X,Y,Z,u,v,cov_uu,cov_uv,cov_vv\n";
+    const std::vector<Eigen::Vector3d> points = {{-0.75, 0, 0}, {-0.25, 0, 0}, {0.25, 0, 0},
+                                                 {0.75, -0.6, 0}, {0.75, 0, 0}, {0.75, 0.6, 0},
+                                                 {0.1, 0.3, -0.2}};
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      Eigen::Vector2d uv = *calibration_.cameras[2].intrinsics.Project(T_C_D_ * points[i]);
+      if (i == 0) uv.x() += 4.0;
+      const double s = i == 0 ? first_sigma : 0.3;
+      text += FormatDouble(points[i].x()) + "," + FormatDouble(points[i].y()) + "," +
+              FormatDouble(points[i].z()) + "," + FormatDouble(uv.x()) + "," +
+              FormatDouble(uv.y()) + "," + FormatDouble(s * s) + ",0," + FormatDouble(s * s) +
+              "\n";
+    }
+    const std::string path = tmp_ / ("cov_" + std::to_string(first_sigma) + ".csv");
+    test::WriteTextFile(path, text + extra);
+    return path;
+  };
+  auto solve = [&](const std::string& path) {
+    const auto r = test::RunAuvdock({"pnp", "--calib", calib_path_, "--camera", "cam2",
+                                     "--points", path});
+    EXPECT_EQ(r.exit_status, 0) << r.err;
+    return nlohmann::json::parse(r.out);
+  };
+  const auto trusted = solve(write(0.3, ""));
+  const auto doubted = solve(write(20.0, ""));
+  auto position_error = [&](const nlohmann::json& j) {
+    return (Eigen::Vector3d(j.at("t")[0], j.at("t")[1], j.at("t")[2]) - T_C_D_.p).norm();
+  };
+  EXPECT_LT(position_error(doubted), 0.2 * position_error(trusted));
+  EXPECT_GT(trusted.at("variance_factor").get<double>(), 3.0);
+  EXPECT_TRUE(trusted.at("covariance_scaled_by_variance_factor").get<bool>());
+  EXPECT_LT(doubted.at("variance_factor").get<double>(), 1.0);
+  EXPECT_FALSE(doubted.at("covariance_scaled_by_variance_factor").get<bool>());
+  EXPECT_EQ(trusted.at("dof").get<int>(), 8);
+
+  const auto r = test::RunAuvdock({"pnp", "--calib", calib_path_, "--camera", "cam2", "--points",
+                                   write(0.3, "0.1,0.2,0,300,200,1,2,1\n")});
+  EXPECT_EQ(r.exit_status, 2);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_THAT(r.err, AllOf(HasSubstr("line 9"), HasSubstr("not positive definite")));
+}
+
 TEST_F(PnpCli, AcceptsOpenCvCalibrationFiles) {
   const std::string path = tmp_ / "opencv.yml";
   const auto& k = calibration_.cameras[2].intrinsics;

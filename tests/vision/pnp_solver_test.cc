@@ -9,6 +9,7 @@
 #include <random>
 #include <string>
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
@@ -361,6 +362,150 @@ TEST(SolvePnp, CovarianceMatchesMonteCarloSpread) {
   EXPECT_NEAR(nees, 6.0, 0.6);
 }
 
+// The default dock seen by the stereo camera 3 m from its centre at 45 degrees (as above).
+struct DockView {
+  CameraCalibration camera;
+  std::vector<Eigen::Vector3d> lights_D;
+  Pose3 T_C_D;
+  std::vector<Eigen::Vector2d> pixels;
+};
+
+DockView DefaultDockView() {
+  const Scenario scenario = test::DefaultScenario();
+  DockView view;
+  view.camera = MakeCalibration(scenario).cameras[0];
+  for (const DockLight& light : scenario.dock.lights) view.lights_D.push_back(light.p_D);
+  const Eigen::Vector3d centre_D(-2.1, 0.3, -2.1);
+  const Eigen::Vector3d z_C = -centre_D.normalized();
+  const Eigen::Vector3d x_C = Eigen::Vector3d::UnitZ().cross(z_C).normalized();
+  Eigen::Matrix3d R_D_C;
+  R_D_C << x_C, z_C.cross(x_C), z_C;
+  view.T_C_D = Pose3(Eigen::Quaterniond(R_D_C), centre_D).Inverse();
+  view.pixels = ProjectAll(view.camera.intrinsics, view.T_C_D, view.lights_D);
+  return view;
+}
+
+Eigen::Matrix<double, 6, 1> LocalError(const Pose3& estimate, const Pose3& truth) {
+  Eigen::Matrix<double, 6, 1> e;
+  e << LogQuaternion(estimate.q * truth.q.conjugate()), estimate.p - truth.p;
+  return e;
+}
+
+Eigen::Matrix<double, 6, 6> SampleCovariance(const std::vector<Eigen::Matrix<double, 6, 1>>& s) {
+  Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
+  for (const auto& e : s) mean += e / s.size();
+  Eigen::Matrix<double, 6, 6> C = Eigen::Matrix<double, 6, 6>::Zero();
+  for (const auto& e : s) C += (e - mean) * (e - mean).transpose() / (s.size() - 1.0);
+  return C;
+}
+
+TEST(SolvePnp, PerPixelCovariancesWeighThePixelsAndMatchTheSpread) {
+  const DockView view = DefaultDockView();
+  // One light smeared along u (3 px), another blurred (1.5 px round), the rest at 0.3 px.
+  std::vector<Eigen::Matrix2d> covariances(view.pixels.size(), 0.09 * Eigen::Matrix2d::Identity());
+  covariances[0] = Eigen::Vector2d(9.0, 0.09).asDiagonal();
+  covariances[2] = 2.25 * Eigen::Matrix2d::Identity();
+  PnpOptions options;
+  options.pixel_sigma = 0.3;
+  const PnpResult reference = SolvePnp(view.lights_D, view.pixels, view.camera.intrinsics, options,
+                                       std::nullopt, covariances);
+  ASSERT_TRUE(reference.ok) << reference.reason;
+  EXPECT_NEAR(reference.chi2, 0.0, 1e-12);
+
+  constexpr int kSamples = 1500;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<Eigen::Matrix<double, 6, 1>> weighted, unweighted;
+  for (int k = 0; k < kSamples; ++k) {
+    auto noisy = view.pixels;
+    for (std::size_t i = 0; i < noisy.size(); ++i) {
+      const Eigen::Matrix2d L = covariances[i].llt().matrixL();
+      noisy[i] += L * Eigen::Vector2d(unit(rng), unit(rng));
+    }
+    const PnpResult w = SolvePnp(view.lights_D, noisy, view.camera.intrinsics, options,
+                                 std::nullopt, covariances);
+    const PnpResult u = SolvePnp(view.lights_D, noisy, view.camera.intrinsics, options);
+    ASSERT_TRUE(w.ok && u.ok) << w.reason << u.reason;
+    weighted.push_back(LocalError(w.T_C_D, view.T_C_D));
+    unweighted.push_back(LocalError(u.T_C_D, view.T_C_D));
+  }
+  const Eigen::Matrix<double, 6, 6> C = SampleCovariance(weighted);
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_NEAR(C(k, k) / reference.covariance_local(k, k), 1.0, 0.15) << k;
+  }
+  // Weighing by the claimed covariances beats treating every pixel alike.
+  const Eigen::Matrix<double, 6, 6> C_unweighted = SampleCovariance(unweighted);
+  const double position_variance = C.bottomRightCorner(3, 3).trace();
+  const double rotation_variance = C.topLeftCorner(3, 3).trace();
+  std::printf("PnP weighted / unweighted variance: position %.3f, rotation %.3f\n",
+              position_variance / C_unweighted.bottomRightCorner(3, 3).trace(),
+              rotation_variance / C_unweighted.topLeftCorner(3, 3).trace());
+  EXPECT_LT(position_variance, 0.5 * C_unweighted.bottomRightCorner(3, 3).trace());
+  EXPECT_LT(rotation_variance, 0.5 * C_unweighted.topLeftCorner(3, 3).trace());
+}
+
+TEST(SolvePnp, TheVarianceFactorWidensTheCovarianceOfPixelsNoisierThanClaimed) {
+  const DockView view = DefaultDockView();
+  const int n = static_cast<int>(view.pixels.size());
+  PnpOptions options;
+  options.pixel_sigma = 0.3;
+  PnpOptions fixed = options;
+  fixed.inflate_by_variance_factor = false;
+  constexpr int kSamples = 1000;
+  for (const double true_sigma : {0.3, 0.9}) {
+    std::mt19937 rng(11);
+    std::normal_distribution<double> noise(0.0, true_sigma);
+    double mean_factor = 0.0, nees = 0.0, nees_fixed = 0.0;
+    for (int k = 0; k < kSamples; ++k) {
+      auto noisy = view.pixels;
+      for (auto& uv : noisy) uv += Eigen::Vector2d(noise(rng), noise(rng));
+      const PnpResult r = SolvePnp(view.lights_D, noisy, view.camera.intrinsics, options);
+      const PnpResult f = SolvePnp(view.lights_D, noisy, view.camera.intrinsics, fixed);
+      ASSERT_TRUE(r.ok && f.ok);
+      EXPECT_EQ(r.dof, 2 * n - 6);
+      EXPECT_NEAR(r.variance_factor, f.variance_factor, 1e-12);
+      const auto e = LocalError(r.T_C_D, view.T_C_D);
+      mean_factor += r.variance_factor / kSamples;
+      nees += e.dot(r.covariance_local.inverse() * e) / kSamples;
+      nees_fixed += e.dot(f.covariance_local.inverse() * e) / kSamples;
+    }
+    const double ratio = true_sigma * true_sigma / (options.pixel_sigma * options.pixel_sigma);
+    std::printf("PnP, noise %.1f px claimed 0.3: mean variance factor %.2f, NEES %.2f (%.2f "
+                "without the factor)\n",
+                true_sigma, mean_factor, nees, nees_fixed);
+    EXPECT_NEAR(mean_factor, ratio, 0.15 * ratio);
+    EXPECT_NEAR(nees_fixed, 6.0 * ratio, 0.15 * 6.0 * ratio);
+    if (ratio > 1.0) {
+      // 9 times too confident without the factor; with it E[NEES] = 6 dof / (dof - 2) = 9.
+      EXPECT_LT(nees, 12.0);
+    } else {
+      // Right as claimed: the factor only ever widens, a little (a fit that happens to be worse).
+      EXPECT_GT(nees, 4.0);
+      EXPECT_LT(nees, 6.3);
+    }
+  }
+}
+
+TEST(CameraInDockCovariance, MapsThePnpPerturbationToTheDockFramesTangentAsFiniteDifferences) {
+  const Pose3 T_C_D(ExpQuaternion(Eigen::Vector3d(0.3, -0.7, 1.1)), Eigen::Vector3d(0.4, -0.2, 3.0));
+  // Columns of the Jacobian by finite differences of T_D_C under each local perturbation.
+  Eigen::Matrix<double, 6, 6> J;
+  const Pose3 T_D_C = T_C_D.Inverse();
+  constexpr double h = 1e-7;
+  for (int k = 0; k < 6; ++k) {
+    Eigen::Matrix<double, 6, 1> d = Eigen::Matrix<double, 6, 1>::Zero();
+    d(k) = h;
+    const Pose3 perturbed(ExpQuaternion(d.head<3>()) * T_C_D.q, T_C_D.p + d.tail<3>());
+    const Pose3 T = perturbed.Inverse();
+    J.col(k) << (T.p - T_D_C.p) / h, LogQuaternion(T.q * T_D_C.q.conjugate()) / h;
+  }
+  Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Random();
+  const Eigen::Matrix<double, 6, 6> P = A * A.transpose() + Eigen::Matrix<double, 6, 6>::Identity();
+  const Eigen::Matrix<double, 6, 6> expected = J * P * J.transpose();
+  EXPECT_TRUE(CameraInDockCovariance(T_C_D, P).isApprox(expected, 1e-6))
+      << CameraInDockCovariance(T_C_D, P) << "\n\n" << expected;
+}
+
 // ---------------------------------------------------------------------------------------------
 // Bad input and degenerate geometry: ok = false with a reason, never a wrong pose.
 
@@ -390,6 +535,26 @@ TEST_F(SolvePnpFailures, TooFewMismatchedOrNonFiniteInput) {
   PnpOptions options;
   options.pixel_sigma = 0.0;
   EXPECT_FALSE(SolvePnp(X, uv, p_.camera, options).ok);
+}
+
+TEST_F(SolvePnpFailures, PixelCovariancesOfTheWrongCountOrNotPositiveDefinite) {
+  PnpOptions options;
+  std::vector<Eigen::Matrix2d> covariances(p_.pixels.size(), Eigen::Matrix2d::Identity());
+  covariances.pop_back();
+  PnpResult r = SolvePnp(p_.points_D, p_.pixels, p_.camera, options, std::nullopt, covariances);
+  EXPECT_FALSE(r.ok);
+  EXPECT_THAT(r.reason, ::testing::HasSubstr("size mismatch"));
+  covariances.push_back(Eigen::Matrix2d::Identity());
+  covariances[1] << 1.0, 2.0, 2.0, 1.0;  // indefinite
+  r = SolvePnp(p_.points_D, p_.pixels, p_.camera, options, std::nullopt, covariances);
+  EXPECT_FALSE(r.ok);
+  EXPECT_THAT(r.reason, ::testing::HasSubstr("pixel covariance 1 is not positive definite"));
+  covariances[1] << 1.0, std::nan(""), std::nan(""), 1.0;
+  r = SolvePnp(p_.points_D, p_.pixels, p_.camera, options, std::nullopt, covariances);
+  EXPECT_FALSE(r.ok);
+  covariances[1] = Eigen::Matrix2d::Identity();
+  r = SolvePnp(p_.points_D, p_.pixels, p_.camera, options, std::nullopt, covariances);
+  EXPECT_TRUE(r.ok) << r.reason;
 }
 
 TEST_F(SolvePnpFailures, CollinearModelPoints) {

@@ -27,6 +27,11 @@ struct LightDetection {
   double colour_excess = 0.0;
 };
 
+// The covariance (pixels^2) that a pose weighs this detection's centre with: its own, with
+// every eigenvalue raised to at least floor_sigma_px^2 (the camera's pixel noise: no centre is
+// trusted beyond it); floor_sigma_px^2 I when it has none (all zero or not finite).
+Eigen::Matrix2d PixelCovarianceAtLeast(const LightDetection& detection, double floor_sigma_px);
+
 // One detection assigned to one dock light.
 struct LightMatch {
   int detection = -1;  // index into the detections of the image

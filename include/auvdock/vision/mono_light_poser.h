@@ -61,9 +61,12 @@ struct MonoPoseResult {
   MatchStatus status = MatchStatus::kFailed;
   bool tracked = false;
   std::optional<Pose3> T_C_D;
+  // Covariance of the left perturbation of T_C_D (dtheta, dt), the camera frame (SolvePnp),
+  // from each light's own centroid covariance, widened by variance_factor when it exceeds 1.
   Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
+  double variance_factor = 1.0;  // the pose's a-posteriori variance factor (SolvePnp)
   double rms_px = 0.0;
-  double pixel_sigma_px = 0.0;  // the noise used
+  double pixel_sigma_px = 0.0;  // the noise of the identification's gates (median detection's)
   int num_lights = 0;           // used in the pose
   std::string reason;           // why there is no pose (empty with a pose)
   std::vector<Pose3> symmetric_T_C_D;  // rival poses of a symmetric dock (symmetry_note)

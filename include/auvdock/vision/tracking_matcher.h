@@ -25,7 +25,11 @@
 //      prediction error; the final labels are checked at the noise level, so a spurious
 //      detection near a missing light's rough position is not taken for it;
 //   4. refuses to guess (kAmbiguous, with the reason) when another offset with the same support
-//      gives a different labelling, or when a matched detection has a second light (or a light
+//      gives a different labelling -- unless the offset nearest the prediction is decisively
+//      nearer than every such rival (each farther than decisive_offset_ratio x max(its |o|,
+//      min_residual_gate_px)), which then wins: a prediction is more likely off by a little than
+//      by a lot, and lights mirrored on a surface below them (reflections, ~3 light radii down)
+//      otherwise explain as many lights at an offset of their own -- or when a matched detection has a second light (or a light
 //      has a second detection) within its gate no more than ambiguity_margin_px farther than
 //      the chosen one -- e.g. two lights projecting onto one detection.
 // r_L = clamp(spacing_fraction * (distance from p_L to the nearest other projected light),
@@ -62,6 +66,9 @@ struct TrackingMatcherOptions {
   // common offset is removed is a fraction of that offset.
   double residual_fraction_of_gate = 0.4;
   double ambiguity_margin_px = 1.0;  // a second choice this close to the first is ambiguous
+  // Step 4: an equally supported offset with another labelling is no rival when it is this many
+  // times as far from the prediction as the nearest one (<= 0: every such offset is a rival).
+  double decisive_offset_ratio = 3.0;
   bool refine_pose = true;           // step 3
   double final_gate_px = 2.5;        // step 3: ~5-8 sigma of the centroid noise (0.3-0.5 px)
   double pixel_noise_px = 0.3;       // step 3: 1-sigma centroid noise per axis
