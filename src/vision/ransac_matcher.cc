@@ -246,7 +246,18 @@ struct Scene {
   std::vector<Eigen::Vector3d> f;  // detections, unit bearings
   double fx = 1.0, fy = 1.0;
   double deck_z = 0.0;  // z_D of the lights' plane (mean z of the lights)
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // of the lights, D
 };
+
+// The camera centre above the deck (z down): at least min_camera_height_m, and seen from the
+// lights' centroid at least min_view_elevation_deg above the deck's plane.
+bool CameraAboveTheDeck(const Scene& scene, const Eigen::Vector3d& camera_D,
+                        const RansacMatcherOptions& options) {
+  const double height = scene.deck_z - camera_D.z();
+  if (!(height > options.min_camera_height_m)) return false;
+  const double sin_min = std::sin(options.min_view_elevation_deg * 3.14159265358979323846 / 180.0);
+  return height >= sin_min * (camera_D - scene.centroid).norm();
+}
 
 struct Hypothesis {
   RigidPose pose;
@@ -261,8 +272,7 @@ bool BetterHypothesis(const Hypothesis& a, const Hypothesis& b) {
 }
 
 bool PlausiblePose(const Scene& scene, const RigidPose& pose, const RansacMatcherOptions& options) {
-  const Eigen::Vector3d camera_D = -pose.R.transpose() * pose.t;
-  if (!(camera_D.z() < scene.deck_z - options.min_camera_height_m)) return false;
+  if (!CameraAboveTheDeck(scene, -pose.R.transpose() * pose.t, options)) return false;
   for (const Eigen::Vector3d& X : scene.X) {
     if (!(pose.R.row(2).dot(X) + pose.t.z() > options.min_depth_m)) return false;
   }
@@ -275,8 +285,7 @@ bool PlausiblePose(const Scene& scene, const RigidPose& pose, const RansacMatche
 bool ScorePose(const Scene& scene, const RigidPose& pose, const RansacMatcherOptions& options,
                std::vector<Eigen::Vector3d>* p_C, std::vector<int>* light_of_detection,
                std::vector<double>* claim_d2, Hypothesis* out) {
-  const Eigen::Vector3d camera_D = -pose.R.transpose() * pose.t;
-  if (!(camera_D.z() < scene.deck_z - options.min_camera_height_m)) return false;
+  if (!CameraAboveTheDeck(scene, -pose.R.transpose() * pose.t, options)) return false;
   p_C->resize(scene.X.size());
   for (size_t i = 0; i < scene.X.size(); ++i) {
     (*p_C)[i] = pose.R * scene.X[i] + pose.t;
@@ -699,6 +708,7 @@ RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, con
     scene.X.push_back(light.p_D);
     scene.ids.push_back(light.id);
     scene.deck_z += light.p_D.z() / num_lights;
+    scene.centroid += light.p_D / num_lights;
   }
   bool planar = true;
   for (const Eigen::Vector3d& X : scene.X) planar = planar && std::abs(X.z() - scene.deck_z) < 1e-6;

@@ -288,6 +288,48 @@ TEST(MatchRansac, VerifiedPoseAndReportedFigures) {
   EXPECT_GT(result.num_p3p, 0);
 }
 
+// The camera 5 m from the T dock's centre at `elevation` above the deck, looking at it.
+Pose3 ViewFromElevation(const DockModel& dock, double elevation_rad, double azimuth_rad) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const DockLight& light : dock.lights) centre += light.p_D / dock.lights.size();
+  const Eigen::Vector3d camera_D =
+      centre + 5.0 * Eigen::Vector3d(-std::cos(elevation_rad) * std::cos(azimuth_rad),
+                                     -std::cos(elevation_rad) * std::sin(azimuth_rad),
+                                     -std::sin(elevation_rad));  // z down: above is -z
+  const Eigen::Vector3d z_C = (centre - camera_D).normalized();
+  const Eigen::Vector3d x_C = Eigen::Vector3d::UnitZ().cross(z_C).normalized();
+  Eigen::Matrix3d R_D_C;
+  R_D_C << x_C, z_C.cross(x_C), z_C;
+  return Pose3(Eigen::Quaterniond(R_D_C), camera_D).Inverse();
+}
+
+// Seen edge-on the lights lie on one image line, where clutter lines up too (a cable, a rim, a
+// light's beam): a pose less than min_view_elevation_deg above the deck is not accepted.
+TEST(MatchRansac, AnEdgeOnViewOfThePlanarDockIsNotAPose) {
+  const DockModel dock = LoadDock("t_shape.yaml");
+  const PinholeRadtanCamera camera = DefaultMonoCamera();
+  std::mt19937_64 rng(7007);
+  RansacMatcherOptions off;
+  off.min_view_elevation_deg = 0.0;
+  int accepted_without = 0;
+  for (int k = 0; k < 10; ++k) {
+    const double azimuth = (20.0 + 7.0 * k) * kDeg;
+    const View edge_on = MakeView(dock, camera, ViewFromElevation(dock, 2.5 * kDeg, azimuth),
+                                  test::AllLightIds(dock), 0, 0.3, rng);
+    const RansacMatchResult refused = MatchRansac(edge_on.detections, dock, camera, {}, rng);
+    EXPECT_NE(refused.status, MatchStatus::kOk) << k;
+    accepted_without +=
+        MatchRansac(edge_on.detections, dock, camera, off, rng).status == MatchStatus::kOk;
+    const View above = MakeView(dock, camera, ViewFromElevation(dock, 12.0 * kDeg, azimuth),
+                                test::AllLightIds(dock), 0, 0.3, rng);
+    const RansacMatchResult posed = MatchRansac(above.detections, dock, camera, {}, rng);
+    ASSERT_EQ(posed.status, MatchStatus::kOk) << k << ": " << posed.reason;
+    EXPECT_EQ(Classify(posed, above), Outcome::kCorrect) << k;
+  }
+  // Without the limit the edge-on views do give poses: the limit is what refuses them.
+  EXPECT_GT(accepted_without, 0);
+}
+
 TEST(MatchRansac, TooFewDetectionsFail) {
   const DockModel dock = LoadDock("t_shape.yaml");
   const PinholeRadtanCamera camera = DefaultMonoCamera();

@@ -20,8 +20,12 @@
 //    (camera on the -z side of the deck, every light in front) the projection preserves the
 //    orientation of every triangle, so only light triples with the detection triple's
 //    orientation are tried (half of them).
-//  * Verification: reject poses with a light closer than min_depth_m to the camera plane or the
-//    camera not min_camera_height_m above the deck; each light claims its nearest detection
+//  * Verification: reject poses with a light closer than min_depth_m to the camera plane, the
+//    camera not min_camera_height_m above the deck, or the camera seen from the lights' centroid
+//    less than min_view_elevation_deg above the deck's plane (an edge-on view puts the lights on
+//    one image line, where a cable, a rim or a light's beam puts a line of clutter: on the
+//    randomised renders every such pose was clutter, 2-3 deg up, metres off; a docking approach
+//    sees the deck from well above that); each light claims its nearest detection
 //    within hypothesis_gate_px; score = (inliers, then squared residual). Distances are in
 //    normalized coordinates scaled by (fx, fy): pixel-equivalent.
 //  * Which triples: a labelling with k >= 4 inlier detections is generated from any of its
@@ -117,6 +121,7 @@ struct RansacMatcherOptions {
   bool require_redundant_support = true;
   double ambiguity_margin_px = 0.75;  // final assignment: second choice this close is ambiguous
   double min_camera_height_m = 0.05;  // camera centre at least this far above the deck
+  double min_view_elevation_deg = 5.0;  // and at least this far above the deck's plane (0: off)
   double min_depth_m = 0.05;          // every light at least this far in front of the camera
   int max_refined_hypotheses = 4;
   int max_detection_triples = 400;  // beyond this, a random subset of detection triples
