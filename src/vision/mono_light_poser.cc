@@ -56,15 +56,7 @@ MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detectio
   // The noise the detections claim (their own covariances), never below the camera's: the
   // median detection's, so that one detection with a wide covariance (a light cut by the border,
   // a blob in a glow) does not widen every gate of the frame.
-  std::vector<double> claimed;
-  for (const LightDetection& d : detections) {
-    if (d.covariance.trace() > 0.0) claimed.push_back(std::sqrt(d.covariance.trace() / 2.0));
-  }
-  double sigma = camera_.pixel_noise_px;
-  if (!claimed.empty()) {
-    std::nth_element(claimed.begin(), claimed.begin() + claimed.size() / 2, claimed.end());
-    sigma = std::max(sigma, claimed[claimed.size() / 2]);
-  }
+  const double sigma = TypicalPixelSigma(detections, camera_.pixel_noise_px);
   result.pixel_sigma_px = sigma;
 
   const bool can_track =
@@ -123,9 +115,10 @@ MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detectio
     return result;
   }
 
-  // The pose weighs each light by its detection's own covariance (a light cut by the border
-  // counts for less), never below the camera's pixel noise; its covariance grows by the
-  // a-posteriori variance factor when the lights fit worse than they claim (SolvePnp step 3).
+  // The pose weighs every light alike, except one whose detection claims far more than the
+  // frame's typical sigma (a light cut by the border counts for less: PixelCovarianceForPose);
+  // its covariance grows by the a-posteriori variance factor when the lights fit worse than
+  // they claim (SolvePnp step 3).
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector2d> pixels;
   std::vector<Eigen::Matrix2d> covariances;
@@ -137,7 +130,7 @@ MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detectio
     points.push_back(light->p_D);
     pixels.push_back(detections[m.detection].uv);
     covariances.push_back(
-        PixelCovarianceAtLeast(detections[m.detection], camera_.pixel_noise_px));
+        PixelCovarianceForPose(detections[m.detection], sigma));
   }
   PnpOptions pnp;
   pnp.pixel_sigma = sigma;

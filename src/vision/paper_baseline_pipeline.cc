@@ -231,18 +231,23 @@ void PaperBaselinePipeline::StereoPose(bool left_identified,
 
 void PaperBaselinePipeline::MonoPose(const std::optional<Pose3>& predicted_T_C_D,
                                      BaselineFrame* frame) {
-  // Each light weighed by its detection's own covariance (a detector that measures none: the
-  // camera's pixel noise), never below the camera's pixel noise.
+  // Every light weighed alike, except one whose detection claims far more than the typical
+  // sigma of the identified ones (PixelCovarianceForPose; a detector that measures no
+  // covariance: the camera's pixel noise for all).
   std::vector<Eigen::Vector3d> points;
   std::vector<Eigen::Vector2d> pixels;
-  std::vector<Eigen::Matrix2d> covariances;
+  std::vector<LightDetection> identified;
   for (std::size_t i = 0; i < frame->mono.detections.size(); ++i) {
     const int id = frame->mono.light_ids[i];
     if (id < 0) continue;
     points.push_back(dock_.FindLight(id)->p_D);
     pixels.push_back(frame->mono.detections[i].uv);
-    covariances.push_back(
-        PixelCovarianceAtLeast(frame->mono.detections[i], mono_->pixel_noise_px));
+    identified.push_back(frame->mono.detections[i]);
+  }
+  const double typical_sigma = TypicalPixelSigma(identified, mono_->pixel_noise_px);
+  std::vector<Eigen::Matrix2d> covariances;
+  for (const LightDetection& d : identified) {
+    covariances.push_back(PixelCovarianceForPose(d, typical_sigma));
   }
   const int needed =
       frame->mono.tracked ? std::min(3, options_.min_mono_lights) : options_.min_mono_lights;

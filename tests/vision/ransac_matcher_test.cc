@@ -320,7 +320,7 @@ TEST(MatchRansac, AnEdgeOnViewOfThePlanarDockIsNotAPose) {
     EXPECT_NE(refused.status, MatchStatus::kOk) << k;
     accepted_without +=
         MatchRansac(edge_on.detections, dock, camera, off, rng).status == MatchStatus::kOk;
-    const View above = MakeView(dock, camera, ViewFromElevation(dock, 12.0 * kDeg, azimuth),
+    const View above = MakeView(dock, camera, ViewFromElevation(dock, 20.0 * kDeg, azimuth),
                                 test::AllLightIds(dock), 0, 0.3, rng);
     const RansacMatchResult posed = MatchRansac(above.detections, dock, camera, {}, rng);
     ASSERT_EQ(posed.status, MatchStatus::kOk) << k << ": " << posed.reason;

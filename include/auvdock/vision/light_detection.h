@@ -27,10 +27,23 @@ struct LightDetection {
   double colour_excess = 0.0;
 };
 
-// The covariance (pixels^2) that a pose weighs this detection's centre with: its own, with
-// every eigenvalue raised to at least floor_sigma_px^2 (the camera's pixel noise: no centre is
-// trusted beyond it); floor_sigma_px^2 I when it has none (all zero or not finite).
+// The detection's own covariance (pixels^2) with every eigenvalue raised to at least
+// floor_sigma_px^2; floor_sigma_px^2 I when it has none (all zero or not finite).
 Eigen::Matrix2d PixelCovarianceAtLeast(const LightDetection& detection, double floor_sigma_px);
+
+// The sigma a frame's detections typically claim: the median of sqrt(trace / 2) over those with
+// a covariance, at least floor_sigma_px (the camera's pixel noise); floor_sigma_px if none has.
+double TypicalPixelSigma(const std::vector<LightDetection>& detections, double floor_sigma_px);
+
+// The covariance (pixels^2) a pose weighs a detection's centre with: typical_sigma_px^2 I,
+// unless the detection claims more than doubt_ratio times that (sqrt(trace / 2): a light cut by
+// the border, a core cut from a bright structure, a blob in another light's glow -- a bias it
+// knows of), then its own covariance, every eigenvalue at least typical_sigma_px^2. The claims'
+// finer differences (tenths of a pixel, from a core's shape or an interlaced smear) are not
+// trusted to weigh one light above another: on the real pool clip weighing every light by its
+// own claim cost LEDs and poses on its perturbed copies (README, "Each light's own covariance").
+Eigen::Matrix2d PixelCovarianceForPose(const LightDetection& detection, double typical_sigma_px,
+                                       double doubt_ratio = 2.0);
 
 // One detection assigned to one dock light.
 struct LightMatch {

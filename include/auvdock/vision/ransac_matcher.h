@@ -24,8 +24,11 @@
 //    camera not min_camera_height_m above the deck, or the camera seen from the lights' centroid
 //    less than min_view_elevation_deg above the deck's plane (an edge-on view puts the lights on
 //    one image line, where a cable, a rim or a light's beam puts a line of clutter: on the
-//    randomised renders every such pose was clutter, 2-3 deg up, metres off; a docking approach
-//    sees the deck from well above that); each light claims its nearest detection
+//    randomised renders every such pose was clutter, 2-3 deg up, metres off, and on the pool
+//    clip's zoomed copies poses 0.3-2 deg up were wrong, where the true views are 58-88 deg;
+//    our scenarios' views with 4 lights are at least 29 deg up. 10 deg would drop the wrong
+//    5-10 deg poses of the zoomed copies too, but cost the clip's poor second camera model
+//    labelled poses: 5 is the default); each light claims its nearest detection
 //    within hypothesis_gate_px; score = (inliers, then squared residual). Distances are in
 //    normalized coordinates scaled by (fx, fy): pixel-equivalent.
 //  * Which triples: a labelling with k >= 4 inlier detections is generated from any of its
