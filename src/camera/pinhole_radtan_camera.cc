@@ -1,16 +1,46 @@
 #include "auvdock/camera/pinhole_radtan_camera.h"
 
 #include <cassert>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Dense>
 
 namespace auvdock {
+namespace {
+
+// d/dr of r (1 + k1 r^2 + k2 r^4 + k3 r^6), as a function of s = r^2.
+double RadialSlope(const std::array<double, 5>& d, double s) {
+  return 1.0 + s * (3.0 * d[0] + s * (5.0 * d[1] + s * 7.0 * d[4]));
+}
+
+// The smallest r where the slope reaches 0: scanned in s up to r = 100 (a ray 89.4 deg off the
+// axis), then bisected.
+double FoldRadius(const std::array<double, 5>& d) {
+  constexpr double kMaxS = 1e4;
+  double lo = 0.0;
+  for (double step = 1e-3; lo < kMaxS; step *= 1.05) {
+    const double hi = std::min(kMaxS, lo + step);
+    if (RadialSlope(d, hi) <= 0.0) {
+      double a = lo, b = hi;
+      for (int i = 0; i < 60; ++i) {
+        const double m = 0.5 * (a + b);
+        (RadialSlope(d, m) > 0.0 ? a : b) = m;
+      }
+      return std::sqrt(a);
+    }
+    lo = hi;
+  }
+  return std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
 
 PinholeRadtanCamera::PinholeRadtanCamera(int width, int height, double fx, double fy, double cx,
                                          double cy, const std::array<double, 5>& distortion)
     : width_(width), height_(height), fx_(fx), fy_(fy), cx_(cx), cy_(cy),
-      distortion_(distortion) {
+      distortion_(distortion), fold_radius_(FoldRadius(distortion)) {
   assert(width > 0 && height > 0 && fx > 0 && fy > 0);
 }
 
@@ -30,7 +60,9 @@ Eigen::Matrix3d PinholeRadtanCamera::K() const {
 std::optional<Eigen::Vector2d> PinholeRadtanCamera::Project(const Eigen::Vector3d& p_C,
                                                             double min_depth) const {
   if (!(p_C.z() > min_depth)) return std::nullopt;
-  return ProjectNormalized(p_C.head<2>() / p_C.z());
+  const Eigen::Vector2d xy = p_C.head<2>() / p_C.z();
+  if (!(xy.norm() < fold_radius_)) return std::nullopt;
+  return ProjectNormalized(xy);
 }
 
 Eigen::Vector2d PinholeRadtanCamera::ProjectNormalized(const Eigen::Vector2d& xy) const {

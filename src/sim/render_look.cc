@@ -217,14 +217,19 @@ std::array<double, 5> DrawStrongDistortion(double max_radius, std::mt19937_64& r
     const std::array<double, 5> d{Uniform(rng, -0.35, -0.1), Uniform(rng, 0.02, 0.15),
                                   Uniform(rng, -0.002, 0.002), Uniform(rng, -0.002, 0.002),
                                   Uniform(rng, -0.03, 0.0)};
-    // d r_d / d r of r (1 + k1 r^2 + k2 r^4 + k3 r^6), checked out to the corner.
+    // d r_d / d r of r_d = r (1 + k1 r^2 + k2 r^4 + k3 r^6), checked along r until r_d reaches
+    // the corner: every pixel of the image is then the image of exactly one ray. (Checked out to
+    // r = max_radius instead, until 2026-12, the corners of barrel-distorted draws lay beyond the
+    // fold, where no ray lands, and lights far outside the view were drawn mid-image.)
     bool monotonic = true;
-    for (double r = 0.0; r <= max_radius + 1e-9; r += max_radius / 50.0) {
+    for (double r = 0.0;; r += max_radius / 200.0) {
       const double r2 = r * r;
+      const double radial = 1.0 + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
       if (1.0 + 3.0 * d[0] * r2 + 5.0 * d[1] * r2 * r2 + 7.0 * d[4] * r2 * r2 * r2 < 0.2) {
         monotonic = false;
         break;
       }
+      if (r * radial >= max_radius) break;
     }
     if (monotonic || attempt == 1000) return d;  // 1000: only for a corner radius far past 1
   }

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "auvdock/camera/pinhole_radtan_camera.h"
 #include "auvdock/sim/image_degradation.h"
 #include "auvdock/sim/underwater_renderer.h"
 #include "tests/testing/render_fixture.h"
@@ -230,10 +231,17 @@ TEST(RenderLook, StrongDistortionIsMonotonicToTheCorner) {
   for (int i = 0; i < 200; ++i) {
     const std::array<double, 5> d = DrawStrongDistortion(0.86, rng);
     EXPECT_LE(d[0], -0.1);
-    for (double r = 0.0; r <= 0.86; r += 0.01) {
+    // Along r until the distorted radius reaches the corner (0.86), the mapping keeps growing:
+    // every pixel out to the corner is the image of one ray, none lies beyond the fold.
+    double r = 0.0;
+    for (; r < 3.0; r += 0.005) {
       const double r2 = r * r;
+      if (r * (1.0 + d[0] * r2 + d[1] * r2 * r2 + d[4] * r2 * r2 * r2) >= 0.86) break;
       EXPECT_GT(1.0 + 3.0 * d[0] * r2 + 5.0 * d[1] * r2 * r2 + 7.0 * d[4] * r2 * r2 * r2, 0.19);
     }
+    EXPECT_LT(r, 3.0) << "the corner is never reached";
+    const PinholeRadtanCamera lens(640, 512, 400.0, 400.0, 319.5, 255.5, d);
+    EXPECT_GT(lens.fold_radius(), r);
   }
 }
 

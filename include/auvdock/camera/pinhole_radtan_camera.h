@@ -8,10 +8,17 @@
 //   y_d = y radial + p1 (r^2 + 2 y^2) + 2 p2 x y
 //   u = fx x_d + cx,  v = fy y_d + cy           (pixels; (0,0) is the centre of the top-left pixel)
 // Coefficients are in OpenCV's order (k1, k2, p1, p2, k3); EuRoC files give the first four.
+// The model holds out to the fold radius r_fold, the smallest r > 0 where the radial mapping
+// r -> r (1 + k1 r^2 + k2 r^4 + k3 r^6) stops growing (d/dr = 1 + 3 k1 r^2 + 5 k2 r^4 + 7 k3 r^6
+// = 0; +infinity when it never does): beyond it the polynomial sends farther rays back towards
+// the image centre (a strongly barrel-distorted lens's k1 = -0.3 folds at ~50 deg off axis, and
+// a light 60 deg off axis would land mid-image), where no lens images them. Project() refuses
+// such points; calibrations are fitted inside the image, so r_fold lies beyond its corners.
 // The templated DistortNormalized() is shared with the Ceres residuals of later issues.
 #pragma once
 
 #include <array>
+#include <limits>
 #include <optional>
 
 #include <Eigen/Core>
@@ -47,7 +54,8 @@ class PinholeRadtanCamera {
   const std::array<double, 5>& distortion() const { return distortion_; }
   Eigen::Matrix3d K() const;
 
-  // Pixel of a point in front of the camera; nullopt if Z <= min_depth.
+  // Pixel of a point in front of the camera; nullopt if Z <= min_depth or the point lies beyond
+  // the fold radius (above).
   std::optional<Eigen::Vector2d> Project(const Eigen::Vector3d& p_C, double min_depth = 1e-6) const;
   // Normalized (undistorted) image coordinates -> pixel.
   Eigen::Vector2d ProjectNormalized(const Eigen::Vector2d& xy) const;
@@ -55,6 +63,9 @@ class PinholeRadtanCamera {
   Eigen::Vector2d Unproject(const Eigen::Vector2d& uv) const;
   // Pixel -> unit bearing vector in C.
   Eigen::Vector3d Bearing(const Eigen::Vector2d& uv) const;
+
+  // r_fold of the header (normalized units; +infinity when the distortion never folds).
+  double fold_radius() const { return fold_radius_; }
 
   // True when the pixel lies inside the image with the given margin (pixels).
   bool InImage(const Eigen::Vector2d& uv, double margin = 0.0) const;
@@ -64,6 +75,7 @@ class PinholeRadtanCamera {
   int height_ = 0;
   double fx_ = 0, fy_ = 0, cx_ = 0, cy_ = 0;
   std::array<double, 5> distortion_{};
+  double fold_radius_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace auvdock

@@ -147,8 +147,9 @@ RenderLook DefaultRenderLook(const DockModel& dock);
 RenderLook DrawRenderLook(const RenderRandomization& randomization, const DockModel& dock,
                           std::mt19937_64& rng);
 
-// Strong radial-tangential distortion (k1, k2, p1, p2, k3), monotonic out to the normalised
-// radius max_radius (the image corner): redrawn until d r_d / d r > 0.2 there.
+// Strong radial-tangential distortion (k1, k2, p1, p2, k3), monotonic over the whole image:
+// redrawn until d r_d / d r > 0.2 for every undistorted radius r whose distorted radius r_d is
+// below max_radius (the image corner's distorted normalised radius, pixels / focal length).
 std::array<double, 5> DrawStrongDistortion(double max_radius, std::mt19937_64& rng);
 
 }  // namespace auvdock
