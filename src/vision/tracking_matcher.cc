@@ -301,6 +301,34 @@ MatchResult MatchByPrediction(const std::vector<LightDetection>& detections, con
     }
   }
   const OffsetSupport& best_candidate = decisive ? *nearest : candidates[best_index];
+  // One light more, far from the prediction: a labelling with one light less decisively nearer
+  // to it, which contradicts the chosen one, may be the truth with a light missed, and the chosen
+  // one a pattern shifted along a row of lights that a spurious detection completes.
+  if (options.decisive_offset_ratio > 0.0) {
+    const double chosen_px = labelled_offset(best_candidate);
+    for (const OffsetSupport& other : candidates) {
+      // Three lights fix an offset (fewer may coincide with clutter anywhere); min_matches does
+      // not apply: the contradicting labelling is not taken, only heard.
+      if (other.count != most - 1 || other.count < 3) continue;
+      const double other_px = labelled_offset(other);
+      if (!(chosen_px > options.decisive_offset_ratio *
+                            std::max(other_px, options.min_residual_gate_px))) {
+        continue;
+      }
+      bool contradicts = false;
+      for (size_t i = 0; i < lights.size() && !contradicts; ++i) {
+        const int j = other.detection_of_light[i];
+        contradicts = j >= 0 && best_candidate.detection_of_light[i] != j;
+      }
+      if (!contradicts) continue;
+      std::ostringstream reason;
+      reason.precision(3);
+      reason << "the labelling of " << most << " lights lies " << chosen_px
+             << " px from the prediction, one of " << other.count << " other lights " << other_px
+             << " px: a light may be missed, or the pattern shifted along a row";
+      return Ambiguous(reason.str());
+    }
+  }
   // Another offset explaining as many lights with a different labelling: refuse to choose.
   for (const OffsetSupport& other : candidates) {
     if (!decisive && other.count == best_candidate.count &&

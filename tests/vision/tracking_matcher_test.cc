@@ -240,6 +240,54 @@ TEST(MatchByPrediction, MirroredLightsFarFromThePredictionDoNotMakeItAmbiguous) 
   EXPECT_GE(chosen, 0.8 * trials);
 }
 
+TEST(MatchByPrediction, AShiftAlongTheStemThatExplainsOneSpuriousLightMoreIsNotTaken) {
+  // The T's stem lights 0, 1, 2 and bar centre 4 are evenly spaced (0.5 m). The bar's lights are
+  // missed; a spurious detection lies where light 3 would be with the whole pattern shifted one
+  // spacing back along the stem. That shift explains 4 detections (0 as 1, 1 as 2, 2 as 4, the
+  // spurious one as 3), the truth 3. The prediction is a pixel off: the shift lies a whole
+  // spacing (8-40 px here) from it.
+  const DockModel dock = LoadDock("t_shape.yaml");
+  const PinholeRadtanCamera camera = DefaultMonoCamera();
+  std::mt19937_64 rng(7);
+  int trials = 0, taken_without_the_rule = 0;
+  for (int i = 0; i < 60 && trials < 25; ++i) {
+    const Pose3 T_C_D = RandomView(dock, camera, 30.0 * kDeg, rng);
+    View view = MakeView(dock, camera, T_C_D, {0, 1, 2}, 0, 0.2, rng);
+    const Eigen::Vector2d p0 = *camera.Project(T_C_D * dock.lights[0].p_D);
+    const Eigen::Vector2d p1 = *camera.Project(T_C_D * dock.lights[1].p_D);
+    const Eigen::Vector2d p3 = *camera.Project(T_C_D * dock.lights[3].p_D);
+    const Eigen::Vector2d spacing = p1 - p0;
+    if (spacing.norm() < 8.0 || spacing.norm() > 40.0) continue;
+    LightDetection spurious = view.detections.front();
+    spurious.uv = p3 - spacing;
+    if (!camera.InImage(spurious.uv)) continue;
+    view.detections.push_back(spurious);
+    view.truth.push_back(-1);
+    ++trials;
+    Pose3 predicted = T_C_D;
+    predicted.q = (ExpQuaternion(Eigen::Vector3d(1.0 / camera.fx(), 0.0, 0.0)) * T_C_D.q);
+    predicted.q.normalize();
+    const MatchResult result = MatchByPrediction(view.detections, dock, camera, predicted, 40.0);
+    EXPECT_NE(Classify(result, view), Outcome::kSilentlyWrong) << i;
+    // As the mono poser tracks: 4 matches at least (the 3 true ones are not enough to take).
+    TrackingMatcherOptions four;
+    four.gate_px = 40.0;
+    four.min_matches = 4;
+    EXPECT_NE(Classify(MatchByPrediction(view.detections, dock, camera, predicted, four), view),
+              Outcome::kSilentlyWrong)
+        << i;
+    TrackingMatcherOptions without;
+    without.gate_px = 40.0;
+    without.decisive_offset_ratio = 0.0;
+    taken_without_the_rule +=
+        Classify(MatchByPrediction(view.detections, dock, camera, predicted, without), view) ==
+        Outcome::kSilentlyWrong;
+  }
+  ASSERT_GE(trials, 15);
+  // Without the rule the shifted pattern is taken: the case is real.
+  EXPECT_GE(taken_without_the_rule, trials / 2);
+}
+
 TEST(MatchByPrediction, TooFewMatchesFail) {
   const DockModel dock = LoadDock("t_shape.yaml");
   const PinholeRadtanCamera camera = DefaultMonoCamera();

@@ -24,14 +24,20 @@
 //      until the labelling is stable. The wide gates of steps 1-2 only have to absorb the
 //      prediction error; the final labels are checked at the noise level, so a spurious
 //      detection near a missing light's rough position is not taken for it;
-//   4. refuses to guess (kAmbiguous, with the reason) when another offset with the same support
-//      gives a different labelling -- unless the offset nearest the prediction is decisively
-//      nearer than every such rival (each farther than decisive_offset_ratio x max(its |o|,
-//      min_residual_gate_px)), which then wins: a prediction is more likely off by a little than
-//      by a lot, and lights mirrored on a surface below them (reflections, ~3 light radii down)
-//      otherwise explain as many lights at an offset of their own -- or when a matched detection has a second light (or a light
-//      has a second detection) within its gate no more than ambiguity_margin_px farther than
-//      the chosen one -- e.g. two lights projecting onto one detection.
+//   4. refuses to guess (kAmbiguous, with the reason)
+//      - when another offset with the same support gives a different labelling -- unless the
+//        offset nearest the prediction is decisively nearer than every such rival (each farther
+//        than decisive_offset_ratio x max(its |o|, min_residual_gate_px)), which then wins: a
+//        prediction is more likely off by a little than by a lot, and lights mirrored on a
+//        surface below them (reflections, ~3 light radii down) otherwise explain as many lights
+//        at an offset of their own;
+//      - when a labelling with one light less contradicts the chosen one from an offset
+//        decisively nearer the prediction (same ratio): along a row of evenly spaced lights (a
+//        T's stem) with one light missed, a spurious detection one spacing beyond the row lets
+//        the pattern shifted by one spacing explain one light more than the truth;
+//      - when a matched detection has a second light (or a light has a second detection) within
+//        its gate no more than ambiguity_margin_px farther than the chosen one -- e.g. two lights
+//        projecting onto one detection.
 // r_L = clamp(spacing_fraction * (distance from p_L to the nearest other projected light),
 //             min_residual_gate_px, residual_fraction_of_gate * gate_px):
 // gates of neighbouring lights do not overlap unless lights project within a few pixels of each
