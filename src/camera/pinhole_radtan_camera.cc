@@ -1,7 +1,7 @@
 #include "auvdock/camera/pinhole_radtan_camera.h"
 
-#include <cassert>
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -10,11 +10,6 @@
 namespace auvdock {
 namespace {
 
-// d/dr of r (1 + k1 r^2 + k2 r^4 + k3 r^6), as a function of s = r^2.
-double RadialSlope(const std::array<double, 5>& d, double s) {
-  return 1.0 + s * (3.0 * d[0] + s * (5.0 * d[1] + s * 7.0 * d[4]));
-}
-
 // The smallest r where the slope reaches 0: scanned in s up to r = 100 (a ray 89.4 deg off the
 // axis), then bisected.
 double FoldRadius(const std::array<double, 5>& d) {
@@ -22,11 +17,11 @@ double FoldRadius(const std::array<double, 5>& d) {
   double lo = 0.0;
   for (double step = 1e-3; lo < kMaxS; step *= 1.05) {
     const double hi = std::min(kMaxS, lo + step);
-    if (RadialSlope(d, hi) <= 0.0) {
+    if (RadialDistortionSlope(d, hi) <= 0.0) {
       double a = lo, b = hi;
       for (int i = 0; i < 60; ++i) {
         const double m = 0.5 * (a + b);
-        (RadialSlope(d, m) > 0.0 ? a : b) = m;
+        (RadialDistortionSlope(d, m) > 0.0 ? a : b) = m;
       }
       return std::sqrt(a);
     }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "auvdock/camera/pinhole_radtan_camera.h"
 #include "auvdock/sim/random_stream.h"
 
 namespace auvdock {
@@ -225,7 +226,7 @@ std::array<double, 5> DrawStrongDistortion(double max_radius, std::mt19937_64& r
     for (double r = 0.0;; r += max_radius / 200.0) {
       const double r2 = r * r;
       const double radial = 1.0 + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
-      if (1.0 + 3.0 * d[0] * r2 + 5.0 * d[1] * r2 * r2 + 7.0 * d[4] * r2 * r2 * r2 < 0.2) {
+      if (RadialDistortionSlope(d, r2) < 0.2) {
         monotonic = false;
         break;
       }

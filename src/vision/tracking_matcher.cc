@@ -22,12 +22,14 @@ struct ProjectedLight {
 };
 
 // Support of one candidate offset: for each projected light, the nearest detection within its
-// residual gate (or -1).
+// residual gate (or -1), and the mean offset of that labelling (detection minus projection over
+// its support; zero without support).
 struct OffsetSupport {
   Eigen::Vector2d offset = Eigen::Vector2d::Zero();
   std::vector<int> detection_of_light;
   int count = 0;
   double squared_residual = 0.0;
+  Eigen::Vector2d labelled_offset = Eigen::Vector2d::Zero();
 };
 
 OffsetSupport Support(const std::vector<LightDetection>& detections,
@@ -48,8 +50,10 @@ OffsetSupport Support(const std::vector<LightDetection>& detections,
     if (support.detection_of_light[i] >= 0) {
       ++support.count;
       support.squared_residual += best;
+      support.labelled_offset += detections[support.detection_of_light[i]].uv - lights[i].uv;
     }
   }
+  support.labelled_offset /= std::max(1, support.count);
   return support;
 }
 
@@ -269,15 +273,8 @@ MatchResult MatchByPrediction(const std::vector<LightDetection>& detections, con
     return Failed("only " + std::to_string(candidates[best_index].count) +
                   " lights have a detection near their predicted position");
   }
-  // The mean offset of a candidate's labelling (detection minus projection over its support).
-  auto labelled_offset = [&](const OffsetSupport& c) {
-    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
-    for (size_t i = 0; i < lights.size(); ++i) {
-      const int j = c.detection_of_light[i];
-      if (j >= 0) sum += detections[j].uv - lights[i].uv;
-    }
-    return (sum / std::max(1, c.count)).norm();
-  };
+  // How far a candidate's labelling lies from the prediction (pixels).
+  auto labelled_offset = [](const OffsetSupport& c) { return c.labelled_offset.norm(); };
   // Among the labellings explaining the most lights, the one nearest the prediction: it wins when
   // every other is decisive_offset_ratio times as far from it.
   const int most = candidates[best_index].count;
@@ -342,12 +339,7 @@ MatchResult MatchByPrediction(const std::vector<LightDetection>& detections, con
       return Ambiguous(reason.str());
     }
   }
-  Eigen::Vector2d offset = Eigen::Vector2d::Zero();
-  for (size_t i = 0; i < lights.size(); ++i) {
-    const int j = best_candidate.detection_of_light[i];
-    if (j >= 0) offset += detections[j].uv - lights[i].uv;
-  }
-  offset /= static_cast<double>(best_candidate.count);
+  const Eigen::Vector2d offset = best_candidate.labelled_offset;
 
   // 2. Gated Hungarian around the offset-corrected projections.
   std::vector<ProjectedLight> shifted = lights;

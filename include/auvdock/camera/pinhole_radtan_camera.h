@@ -34,6 +34,12 @@ void DistortNormalized(const std::array<double, 5>& d, const T& x, const T& y, T
   *y_d = y * radial + T(d[2]) * (r2 + T(2.0) * y * y) + T(d[3]) * xy2;
 }
 
+// d r_d / d r of the radial mapping r_d = r (1 + k1 r^2 + k2 r^4 + k3 r^6), as a function of
+// r2 = r^2: 1 + 3 k1 r^2 + 5 k2 r^4 + 7 k3 r^6 (its first zero is the fold radius, above).
+inline double RadialDistortionSlope(const std::array<double, 5>& d, double r2) {
+  return 1.0 + r2 * (3.0 * d[0] + r2 * (5.0 * d[1] + r2 * 7.0 * d[4]));
+}
+
 class PinholeRadtanCamera {
  public:
   PinholeRadtanCamera() = default;
