@@ -26,6 +26,8 @@ BlobLightDetector::BlobLightDetector(const BlobLightDetectorOptions& options) : 
       !(options.checks.halo_radius_sigmas > 0.0) || !(options.checks.max_core_elongation >= 1.0) ||
       !(options.checks.max_core_stretch_px >= 0.0) || !(options.close_light_min_sigma_px > 0.0) ||
       !(options.checks.surroundings_halo_radii >= 0.0) ||
+      !(options.checks.small_core_sigmas >= 0.0) ||
+      !(options.checks.small_core_min_drop_fraction >= 0.0) ||
       !(options.checks.surroundings_quantile >= 0.0 && options.checks.surroundings_quantile <= 1.0) ||
       !(options.checks.min_own_colour_fraction >= 0.0 &&
         options.checks.min_own_colour_fraction <= 1.0)) {

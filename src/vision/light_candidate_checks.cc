@@ -174,6 +174,10 @@ std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore&
       (structure_beside && evidence.open_drop < options.min_open_drop_fraction * contrast)) {
     return "not a peak";
   }
+  if (core.radius_px < options.small_core_sigmas * candidate.sigma_px &&
+      evidence.peak_drop < options.small_core_min_drop_fraction * contrast) {
+    return "not a peak (a small bump on a larger structure)";
+  }
   if (!evidence.saturated && candidate.sigma_px >= options.min_flat_sigma_px &&
       evidence.flatness > options.max_flatness) {
     return "flat top (a lit surface)";

@@ -19,7 +19,8 @@ BlobLightDetectorOptions WeakOptions(const MonoLightPipelineOptions& options) {
       !(options.weak_min_support >= 0.0 && options.weak_min_support <= 1.0) ||
       !(options.tracking_motion_px > 0.0) || !(options.unexplained_gate_sigmas >= 0.0) ||
       !(options.unexplained_floor_px >= 0.0) ||
-      !(options.unexplained_min_support >= 0.0 && options.unexplained_min_support <= 1.0)) {
+      !(options.unexplained_min_support >= 0.0 && options.unexplained_min_support <= 1.0) ||
+      !(options.weak_min_view_elevation_deg >= 0.0 && options.weak_min_view_elevation_deg < 90.0)) {
     throw std::invalid_argument("MonoLightPipelineOptions out of range");
   }
   BlobLightDetectorOptions weak = options.detector;
@@ -122,7 +123,11 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
       const auto t3 = Clock::now();
       // A pose from weak blobs must explain most of the dock it puts in view (clutter can fit a
       // few lights of a layout, rarely most of them); one that does not is not tracked from.
+      RansacMatcherOptions weak_view = options_.poser.ransac;
+      weak_view.min_view_elevation_deg =
+          std::max(weak_view.min_view_elevation_deg, options_.weak_min_view_elevation_deg);
       const auto explains_most = [&](const MonoPoseResult& r) {
+        if (!CameraAboveTheDeck(dock_, *r.T_C_D, weak_view)) return false;
         const size_t in_view = PredictLights(dock_, camera_.intrinsics, *r.T_C_D,
                                              Eigen::Matrix<double, 6, 6>::Zero(), {})
                                    .size();

@@ -34,7 +34,7 @@ MonoPoseResult MonoLightPoser::Retry(const std::vector<LightDetection>& detectio
     refused.light_ids.assign(detections.size(), -1);
     refused.pixel_sigma_px = result.pixel_sigma_px;
     refused.reason = "a pose of " + std::to_string(result.num_lights) +
-                     " lights, refused (too little of the dock)";
+                     " lights, refused (too little of the dock, or the deck seen edge-on)";
     return refused;
   }
   return result;
@@ -138,6 +138,15 @@ MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detectio
   if (!pose.ok) {
     result.status = MatchStatus::kFailed;
     result.reason = "pnp: " + pose.reason;
+    return result;
+  }
+  // Tracking and PnP's refinement never tested where the camera is: a labelling carried from
+  // frame to frame can drift to a pose edge-on to the deck or under it (clutter along a cable
+  // fits a layout seen edge-on), which no camera over a dock on the seabed sees.
+  if (!CameraAboveTheDeck(dock_, pose.T_C_D, options_.ransac)) {
+    result.status = MatchStatus::kFailed;
+    result.reason = std::string(result.tracked ? "tracking" : "pnp") +
+                    ": the camera would be edge-on to the deck or under it";
     return result;
   }
   result.light_ids = ids;

@@ -251,12 +251,17 @@ struct Scene {
 
 // The camera centre above the deck (z down): at least min_camera_height_m, and seen from the
 // lights' centroid at least min_view_elevation_deg above the deck's plane.
-bool CameraAboveTheDeck(const Scene& scene, const Eigen::Vector3d& camera_D,
-                        const RansacMatcherOptions& options) {
-  const double height = scene.deck_z - camera_D.z();
+bool CameraAboveTheDeck(double deck_z, const Eigen::Vector3d& centroid,
+                        const Eigen::Vector3d& camera_D, const RansacMatcherOptions& options) {
+  const double height = deck_z - camera_D.z();
   if (!(height > options.min_camera_height_m)) return false;
   const double sin_min = std::sin(options.min_view_elevation_deg * 3.14159265358979323846 / 180.0);
-  return height >= sin_min * (camera_D - scene.centroid).norm();
+  return height >= sin_min * (camera_D - centroid).norm();
+}
+
+bool CameraAboveTheDeck(const Scene& scene, const Eigen::Vector3d& camera_D,
+                        const RansacMatcherOptions& options) {
+  return CameraAboveTheDeck(scene.deck_z, scene.centroid, camera_D, options);
 }
 
 struct Hypothesis {
@@ -654,6 +659,18 @@ struct DetectionTriple {
 };
 
 }  // namespace
+
+bool CameraAboveTheDeck(const DockModel& dock, const Pose3& T_C_D,
+                        const RansacMatcherOptions& options) {
+  if (dock.lights.empty()) return false;
+  double deck_z = 0.0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const DockLight& light : dock.lights) {
+    deck_z += light.p_D.z() / static_cast<double>(dock.lights.size());
+    centroid += light.p_D / static_cast<double>(dock.lights.size());
+  }
+  return CameraAboveTheDeck(deck_z, centroid, T_C_D.Inverse().p, options);
+}
 
 std::vector<Pose3> SolveP3P(const std::array<Eigen::Vector3d, 3>& bearings_C,
                             const std::array<Eigen::Vector3d, 3>& points_D) {

@@ -27,6 +27,21 @@ DockModel LoadDock(const std::string& name) {
   return LoadDockModel(SourcePath("data/docks/" + name));
 }
 
+Pose3 ViewFromElevation(const DockModel& dock, double distance_m, double elevation_rad,
+                        double azimuth_rad) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const DockLight& light : dock.lights) centre += light.p_D / dock.lights.size();
+  const Eigen::Vector3d camera_D =
+      centre + distance_m * Eigen::Vector3d(-std::cos(elevation_rad) * std::cos(azimuth_rad),
+                                            -std::cos(elevation_rad) * std::sin(azimuth_rad),
+                                            -std::sin(elevation_rad));
+  const Eigen::Vector3d z_C = (centre - camera_D).normalized();
+  const Eigen::Vector3d x_C = Eigen::Vector3d::UnitZ().cross(z_C).normalized();
+  Eigen::Matrix3d R_D_C;
+  R_D_C << x_C, z_C.cross(x_C), z_C;
+  return Pose3(Eigen::Quaterniond(R_D_C), camera_D).Inverse();
+}
+
 Pose3 RandomView(const DockModel& dock, const PinholeRadtanCamera& camera, double max_tilt_rad,
                  std::mt19937_64& rng) {
   std::uniform_real_distribution<double> yaw(0.0, 360.0 * kDeg);

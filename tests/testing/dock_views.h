@@ -24,6 +24,12 @@ DockModel LoadDock(const std::string& name);
 Pose3 RandomView(const DockModel& dock, const PinholeRadtanCamera& camera, double max_tilt_rad,
                  std::mt19937_64& rng);
 
+// The camera distance_m from the lights' centroid, elevation_rad above the deck's plane (z_D
+// down: above is -z) and at azimuth_rad about z_D from behind the dock (0: on the -x side),
+// looking at the centroid with its x axis level. Returns T_C_D.
+Pose3 ViewFromElevation(const DockModel& dock, double distance_m, double elevation_rad,
+                        double azimuth_rad);
+
 // What a light detector would report for a view, with the truth.
 struct View {
   Pose3 T_C_D;

@@ -330,6 +330,42 @@ TEST(MonoLightPoser, ARefusedRetryLeavesTheTrackAsItWas) {
   EXPECT_LT((poser.TrackedPose()->p - accepted.T_C_D->p).norm(), 1e-12);
 }
 
+// Tracking carries a labelling down to a view edge-on to the deck, where the lights fit as well as
+// anywhere; no camera over a dock on the seabed sees it from there (CameraAboveTheDeck, the
+// matcher's own test of its hypotheses), so that frame has no pose and the track stays where it
+// was.
+TEST(MonoLightPoser, ATrackedPoseEdgeOnToTheDeckIsRefused) {
+  const CameraCalibration camera = MonoCalibration();
+  const DockModel dock = test::LoadDock("t_shape.yaml");
+  auto descend = [&](const MonoLightPoserOptions& options) {
+    std::mt19937_64 rng(6);
+    MonoLightPoser poser(camera, dock, options);
+    std::vector<MonoPoseResult> results;
+    for (double elevation : {30.0, 24.0, 18.0, 13.0, 9.0, 6.0, 4.0}) {
+      const test::View view =
+          test::MakeView(dock, camera.intrinsics,
+                         test::ViewFromElevation(dock, 2.5, elevation * kDeg, 45.0 * kDeg),
+                         test::AllLightIds(dock), 0, 0.05, rng);
+      results.push_back(poser.Process(view.detections));
+    }
+    return results;
+  };
+  const std::vector<MonoPoseResult> refused = descend(MonoLightPoserOptions{});
+  for (size_t k = 0; k + 1 < refused.size(); ++k) {
+    ASSERT_TRUE(refused[k].T_C_D.has_value()) << k << ": " << refused[k].reason;
+    EXPECT_EQ(refused[k].tracked, k > 0);
+  }
+  EXPECT_FALSE(refused.back().T_C_D.has_value());
+  EXPECT_EQ(refused.back().reason, "tracking: the camera would be edge-on to the deck or under it");
+  MonoLightPoserOptions no_limit;
+  no_limit.ransac.min_view_elevation_deg = 0.0;
+  const std::vector<MonoPoseResult> kept = descend(no_limit);
+  ASSERT_TRUE(kept.back().T_C_D.has_value()) << kept.back().reason;
+  EXPECT_TRUE(kept.back().tracked);
+  const Pose3 truth = test::ViewFromElevation(dock, 2.5, 4.0 * kDeg, 45.0 * kDeg);
+  EXPECT_LT((kept.back().T_C_D->Inverse().p - truth.Inverse().p).norm(), 0.05);
+}
+
 // Guesses only tracking may label: a failed tracked-only frame identifies nothing from scratch
 // and leaves the tracking state as it was.
 TEST(MonoLightPoser, TrackedOnlyNeverIdentifiesFromScratchNorForgetsTheTrack) {

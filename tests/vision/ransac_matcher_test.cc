@@ -290,17 +290,7 @@ TEST(MatchRansac, VerifiedPoseAndReportedFigures) {
 
 // The camera 5 m from the T dock's centre at `elevation` above the deck, looking at it.
 Pose3 ViewFromElevation(const DockModel& dock, double elevation_rad, double azimuth_rad) {
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-  for (const DockLight& light : dock.lights) centre += light.p_D / dock.lights.size();
-  const Eigen::Vector3d camera_D =
-      centre + 5.0 * Eigen::Vector3d(-std::cos(elevation_rad) * std::cos(azimuth_rad),
-                                     -std::cos(elevation_rad) * std::sin(azimuth_rad),
-                                     -std::sin(elevation_rad));  // z down: above is -z
-  const Eigen::Vector3d z_C = (centre - camera_D).normalized();
-  const Eigen::Vector3d x_C = Eigen::Vector3d::UnitZ().cross(z_C).normalized();
-  Eigen::Matrix3d R_D_C;
-  R_D_C << x_C, z_C.cross(x_C), z_C;
-  return Pose3(Eigen::Quaterniond(R_D_C), camera_D).Inverse();
+  return test::ViewFromElevation(dock, 5.0, elevation_rad, azimuth_rad);
 }
 
 // Seen edge-on the lights lie on one image line, where clutter lines up too (a cable, a rim, a
@@ -328,6 +318,27 @@ TEST(MatchRansac, AnEdgeOnViewOfThePlanarDockIsNotAPose) {
   }
   // Without the limit the edge-on views do give poses: the limit is what refuses them.
   EXPECT_GT(accepted_without, 0);
+}
+
+// The same test for a pose from elsewhere (tracking, a refinement): the limits apply to where the
+// camera is, whatever it looks at.
+TEST(CameraAboveTheDeck, OnlyViewsFromWellAboveTheDeckPass) {
+  const DockModel dock = LoadDock("t_shape.yaml");
+  const RansacMatcherOptions options;  // 5 deg, 0.05 m
+  for (double azimuth : {0.0, 70.0, 200.0}) {
+    EXPECT_TRUE(CameraAboveTheDeck(dock, ViewFromElevation(dock, 20.0 * kDeg, azimuth * kDeg),
+                                   options));
+    EXPECT_TRUE(CameraAboveTheDeck(dock, ViewFromElevation(dock, 5.5 * kDeg, azimuth * kDeg),
+                                   options));
+    EXPECT_FALSE(CameraAboveTheDeck(dock, ViewFromElevation(dock, 4.5 * kDeg, azimuth * kDeg),
+                                    options));
+    EXPECT_FALSE(CameraAboveTheDeck(dock, ViewFromElevation(dock, -10.0 * kDeg, azimuth * kDeg),
+                                    options));
+  }
+  RansacMatcherOptions off;
+  off.min_view_elevation_deg = 0.0;
+  EXPECT_TRUE(CameraAboveTheDeck(dock, ViewFromElevation(dock, 1.0 * kDeg, 0.0), off));
+  EXPECT_FALSE(CameraAboveTheDeck(dock, ViewFromElevation(dock, -1.0 * kDeg, 0.0), off));
 }
 
 TEST(MatchRansac, TooFewDetectionsFail) {

@@ -76,6 +76,15 @@ struct LightCandidateCheckOptions {
   // gives it ~15 % of its contrast).
   int open_sectors = 5;
   double min_open_drop_fraction = 0.4;
+  // A core under small_core_sigmas of its blob's scale is a small bump on whatever set that
+  // scale. A light whose bloom sets it (a saturated LED in a wide glow: cores of 0.03-0.2 sigma on
+  // the pool clip) stands far above every sector of its ring (drops of 0.7-0.8 of its contrast);
+  // a bump on the edge of a lit funnel or deck has the structure in one sector (0.03-0.23). So
+  // such a core must drop by small_core_min_drop_fraction of its contrast in every sector,
+  // saturated or not. Measured: 146 of the randomised renders' ~750 false detections and 4 of the
+  // pool clip's (a funnel edge, a dim patch) are such bumps; no light of either was (2026-12-06).
+  double small_core_sigmas = 0.2;
+  double small_core_min_drop_fraction = 0.3;
   double max_core_radius_sigmas = 2.0;  // a core wider than this is a bright surface
   double max_flatness = 0.85;
   // A light's core is round: an emitting disc seen through round optics (motion blur, the two
@@ -116,7 +125,8 @@ double MedianColourExcess(const cv::Mat& bgr, LightColour colour);
 
 // Empty when the candidate passes; otherwise a short reason ("extended", "cut by the
 // border" (the core itself reaches the image's edge: its centre is biased by an unknown amount
-// and the light may be mostly outside), "not a peak", "flat top", "the colour of its
+// and the light may be mostly outside), "not a peak" (also "... (a small bump on a larger
+// structure)"), "flat top", "the colour of its
 // surroundings", "wrong colour").
 std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore& core,
                                 const LightCandidateEvidence& evidence, bool has_colour,

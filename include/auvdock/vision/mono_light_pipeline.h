@@ -17,7 +17,8 @@
 //      the far, dim lights of a first approach), and only its detections that the
 //      identification verifies against the dock are kept (with the first pass's other
 //      detections), if its pose identifies at least weak_min_support of the lights it puts in
-//      the image; a pose that does not is neither reported nor tracked from
+//      the image and sees the deck from weak_min_view_elevation_deg above its plane or more; a
+//      pose that does not is neither reported nor tracked from
 //      (MonoLightPoser::Retry's accept). Also after a first pass with min_lights detections or
 //      more whose identification failed (weak_pass_after_failed_identification): 3 lights and a
 //      bright fitting are ambiguous, the 3 dimmer lights beside them settle it.
@@ -66,6 +67,12 @@ struct MonoLightPipelineOptions {
   double weak_min_response = 12.0;
   double weak_halo_fraction = 0.3;
   double weak_min_support = 0.75;  // of the dock's lights that the weak pass's pose puts in view
+  // And it must see the deck from at least this far above its plane (the matcher's own limit,
+  // RansacMatcherOptions::min_view_elevation_deg, is 5 deg for the pool clip's poor camera
+  // model): seen edge-on, a layout's lights lie on one image line, where a cable or a rim puts a
+  // row of weak bumps (randomised renders: a cable fitted the T dock 5.3 deg up, 20 m off, while
+  // every true view with 4 lights or more is at least 29 deg up; the pool clip's are 58-88).
+  double weak_min_view_elevation_deg = 10.0;
   bool weak_pass_after_failed_identification = true;  // false: only after < min_lights
   bool keep_unexplained = false;  // step 6 off
   double unexplained_gate_sigmas = 3.0;

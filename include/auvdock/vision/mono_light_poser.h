@@ -10,7 +10,9 @@
 // C_i a detection's own centroid covariance (zero: not measured), so that PnP's covariance and
 // the matcher's consistency tests follow the detector's stated accuracy. A PnP fit worse than
 // that noise explains inflates the covariance by the a-posteriori variance factor
-// s0^2 = (sum of squared residuals) / (sigma^2 (2 n - 6)) when s0^2 > 1.
+// s0^2 = (sum of squared residuals) / (sigma^2 (2 n - 6)) when s0^2 > 1. The refined pose,
+// tracked or not, must see the deck as the matcher's hypotheses must (CameraAboveTheDeck with
+// ransac's limits): a labelling carried by tracking is otherwise never tested there.
 //
 // A symmetric dock's rival poses (dock_symmetry.h) are told apart by the last pose (the symmetry
 // copy nearest to it in rotation), else by gravity_C when given, else reported unresolved with

@@ -179,6 +179,13 @@ RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, con
                               const RansacMatcherOptions& options, std::mt19937_64& rng,
                               const SymmetryHint& hint);
 
+// The matcher's test of where a camera may be, for a pose found some other way (tracking, PnP's
+// refinement): the camera of T_C_D at least min_camera_height_m above the deck's plane (the
+// lights' mean z_D, z down) and seen from the lights' centroid at least min_view_elevation_deg
+// above it. A pose that fails it is edge-on to the dock or under it.
+bool CameraAboveTheDeck(const DockModel& dock, const Pose3& T_C_D,
+                        const RansacMatcherOptions& options);
+
 // The minimal solver on its own: poses T_C_D (up to four) with bearing i (unit, camera frame)
 // pointing at point i (dock frame), all three in front of the camera.
 std::vector<Pose3> SolveP3P(const std::array<Eigen::Vector3d, 3>& bearings_C,
