@@ -212,6 +212,32 @@ TEST(MonoLightPipeline, DimFarLightsGetAPoseFromTheLaxerPass) {
   EXPECT_LT((frame.pose.T_C_D->p - T_C_D.p).norm(), 0.15);
 }
 
+// The laxer pass's pose must see the deck from weak_min_view_elevation_deg up: seen edge-on a
+// layout's lights lie near one image line, where a cable's or a rim's row of weak bumps fits it.
+// The same dim lights seen 7 deg up give a pose only when the limit is the matcher's 5 deg.
+TEST(MonoLightPipeline, TheLaxerPassTakesNoPoseNearlyEdgeOnToTheDeck) {
+  const CameraCalibration camera = MonoCalibration();
+  const DockModel dock = test::LoadDock("t_shape.yaml");
+  const Pose3 T_C_D = test::ViewFromElevation(dock, 3.0, 7.0 * kDeg, 45.0 * kDeg);
+  std::vector<std::pair<int, double>> lights;
+  for (const DockLight& light : dock.lights) lights.emplace_back(light.id, 40.0);
+  const cv::Mat image =
+      DrawLights(Background(camera.intrinsics, 8), dock, camera.intrinsics, T_C_D, lights, 2.5, 8);
+
+  MonoLightPipeline refusing(camera, dock, PipelineOptions(true));  // 10 deg by default
+  const MonoLightFrame refused = refusing.Process(image);
+  EXPECT_FALSE(refused.pose.T_C_D.has_value());
+  EXPECT_FALSE(refused.pose.reason.empty());
+
+  MonoLightPipelineOptions options = PipelineOptions(true);
+  options.weak_min_view_elevation_deg = 5.0;
+  MonoLightPipeline accepting(camera, dock, options);
+  const MonoLightFrame frame = accepting.Process(image);
+  ASSERT_TRUE(frame.pose.T_C_D.has_value()) << frame.pose.reason;
+  EXPECT_TRUE(frame.from_weak_pass);
+  EXPECT_LT((frame.pose.T_C_D->Inverse().p - T_C_D.Inverse().p).norm(), 0.15);
+}
+
 TEST(MonoLightPipeline, WeakClutterAloneGivesNoPose) {
   const CameraCalibration camera = MonoCalibration();
   const DockModel dock = test::LoadDock("t_shape.yaml");
