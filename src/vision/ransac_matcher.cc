@@ -245,15 +245,23 @@ struct Scene {
   std::vector<Eigen::Vector2d> x;  // detections, undistorted normalized coordinates
   std::vector<Eigen::Vector3d> f;  // detections, unit bearings
   double fx = 1.0, fy = 1.0;
-  double deck_z = 0.0;  // z_D of the lights' plane (mean z of the lights)
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // of the lights, D
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // of the lights, D; z: the deck's plane
 };
 
-// The camera centre above the deck (z down): at least min_camera_height_m, and seen from the
-// lights' centroid at least min_view_elevation_deg above the deck's plane.
-bool CameraAboveTheDeck(double deck_z, const Eigen::Vector3d& centroid,
-                        const Eigen::Vector3d& camera_D, const RansacMatcherOptions& options) {
-  const double height = deck_z - camera_D.z();
+Eigen::Vector3d LightsCentroid(const DockModel& dock) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const DockLight& light : dock.lights) {
+    centroid += light.p_D / static_cast<double>(dock.lights.size());
+  }
+  return centroid;
+}
+
+// The camera centre above the deck (z down, the deck's plane at the lights' mean z): at least
+// min_camera_height_m, and seen from the lights' centroid at least min_view_elevation_deg above
+// the deck's plane.
+bool CameraAboveTheDeck(const Eigen::Vector3d& centroid, const Eigen::Vector3d& camera_D,
+                        const RansacMatcherOptions& options) {
+  const double height = centroid.z() - camera_D.z();
   if (!(height > options.min_camera_height_m)) return false;
   const double sin_min = std::sin(options.min_view_elevation_deg * 3.14159265358979323846 / 180.0);
   return height >= sin_min * (camera_D - centroid).norm();
@@ -261,7 +269,7 @@ bool CameraAboveTheDeck(double deck_z, const Eigen::Vector3d& centroid,
 
 bool CameraAboveTheDeck(const Scene& scene, const Eigen::Vector3d& camera_D,
                         const RansacMatcherOptions& options) {
-  return CameraAboveTheDeck(scene.deck_z, scene.centroid, camera_D, options);
+  return CameraAboveTheDeck(scene.centroid, camera_D, options);
 }
 
 struct Hypothesis {
@@ -663,13 +671,7 @@ struct DetectionTriple {
 bool CameraAboveTheDeck(const DockModel& dock, const Pose3& T_C_D,
                         const RansacMatcherOptions& options) {
   if (dock.lights.empty()) return false;
-  double deck_z = 0.0;
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const DockLight& light : dock.lights) {
-    deck_z += light.p_D.z() / static_cast<double>(dock.lights.size());
-    centroid += light.p_D / static_cast<double>(dock.lights.size());
-  }
-  return CameraAboveTheDeck(deck_z, centroid, T_C_D.Inverse().p, options);
+  return CameraAboveTheDeck(LightsCentroid(dock), T_C_D.Inverse().p, options);
 }
 
 std::vector<Pose3> SolveP3P(const std::array<Eigen::Vector3d, 3>& bearings_C,
@@ -724,11 +726,10 @@ RansacMatchResult MatchRansac(const std::vector<LightDetection>& detections, con
   for (const DockLight& light : dock.lights) {
     scene.X.push_back(light.p_D);
     scene.ids.push_back(light.id);
-    scene.deck_z += light.p_D.z() / num_lights;
-    scene.centroid += light.p_D / num_lights;
   }
+  scene.centroid = LightsCentroid(dock);
   bool planar = true;
-  for (const Eigen::Vector3d& X : scene.X) planar = planar && std::abs(X.z() - scene.deck_z) < 1e-6;
+  for (const Eigen::Vector3d& X : scene.X) planar = planar && std::abs(X.z() - scene.centroid.z()) < 1e-6;
   for (const LightDetection& detection : detections) {
     const Eigen::Vector2d x = camera.Unproject(detection.uv);
     scene.x.push_back(x);
