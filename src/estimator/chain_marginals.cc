@@ -6,7 +6,8 @@
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
-#include <ceres/crs_matrix.h>
+
+#include "auvdock/estimator/chain_linearization.h"
 
 namespace auvdock {
 namespace {
@@ -24,77 +25,17 @@ struct ScaledChain {
 std::optional<ScaledChain> AssembleScaledChain(ceres::Problem* problem,
                                                const std::vector<std::vector<double*>>& states) {
   const int n = static_cast<int>(states.size());
+  const std::optional<ChainLayout> layout = MakeChainLayout(*problem, states);
+  if (!layout) return std::nullopt;
   ScaledChain chain;
-  chain.start.assign(n + 1, 0);
-  std::vector<double*> blocks;
-  for (int k = 0; k < n; ++k) {
-    int size = 0;
-    for (double* block : states[k]) {
-      if (!problem->HasParameterBlock(block)) {
-        throw std::invalid_argument("ChainMarginals: a block is not in the problem");
-      }
-      if (problem->IsParameterBlockConstant(block)) return std::nullopt;
-      blocks.push_back(block);
-      size += problem->ParameterBlockTangentSize(block);
-    }
-    chain.start[k + 1] = chain.start[k] + size;
-  }
-  if (static_cast<int>(blocks.size()) != problem->NumParameterBlocks()) return std::nullopt;
-  const int columns = chain.start[n];
-  std::vector<int> state_of(columns);
-  for (int k = 0; k < n; ++k) {
-    for (int c = chain.start[k]; c < chain.start[k + 1]; ++c) state_of[c] = k;
-  }
-  chain.D.resize(n);
-  chain.B.resize(n > 0 ? n - 1 : 0);
-  chain.joined.assign(n > 0 ? n - 1 : 0, false);
-  for (int k = 0; k < n; ++k) {
-    const int size = chain.start[k + 1] - chain.start[k];
-    chain.D[k] = Eigen::MatrixXd::Zero(size, size);
-    if (k + 1 < n) chain.B[k] = Eigen::MatrixXd::Zero(size, chain.start[k + 2] - chain.start[k + 1]);
-  }
+  chain.start = layout->start;
   if (n == 0) return chain;
-
-  ceres::Problem::EvaluateOptions evaluate;
-  evaluate.parameter_blocks = blocks;
-  evaluate.apply_loss_function = true;
-  ceres::CRSMatrix crs;
-  if (!problem->Evaluate(evaluate, nullptr, nullptr, nullptr, &crs)) return std::nullopt;
-  // H = J^T J accumulated straight into the blocks. Consecutive rows with the same columns (one
-  // residual block's rows) form a small dense J_g; J_g^T J_g is scattered into D and B (a group
-  // touches one state or two neighbours). D[k] gets both triangles; B[k] = H_{k,k+1} only.
-  Eigen::MatrixXd J_g, H_g;
-  int row = 0;
-  while (row < crs.num_rows) {
-    const int begin = crs.rows[row], width = crs.rows[row + 1] - begin;
-    int rows = 1;
-    while (row + rows < crs.num_rows &&
-           crs.rows[row + rows + 1] - crs.rows[row + rows] == width &&
-           std::equal(crs.cols.begin() + begin, crs.cols.begin() + begin + width,
-                      crs.cols.begin() + crs.rows[row + rows])) {
-      ++rows;
-    }
-    J_g.resize(rows, width);
-    for (int i = 0; i < rows; ++i) {
-      for (int j = 0; j < width; ++j) J_g(i, j) = crs.values[crs.rows[row + i] + j];
-    }
-    H_g.noalias() = J_g.transpose() * J_g;
-    for (int a = 0; a < width; ++a) {
-      const int ca = crs.cols[begin + a], ka = state_of[ca];
-      for (int b = 0; b < width; ++b) {
-        const int cb = crs.cols[begin + b], kb = state_of[cb];
-        if (ka == kb) {
-          chain.D[ka](ca - chain.start[ka], cb - chain.start[ka]) += H_g(a, b);
-        } else if (kb == ka + 1) {
-          chain.B[ka](ca - chain.start[ka], cb - chain.start[kb]) += H_g(a, b);
-          chain.joined[ka] = true;
-        } else if (std::abs(ka - kb) > 1) {
-          return std::nullopt;  // not a chain
-        }
-      }
-    }
-    row += rows;
-  }
+  std::optional<ChainLinearization> lin = LinearizeChain(*problem, *layout);
+  if (!lin) return std::nullopt;
+  chain.D = std::move(lin->D);
+  chain.B = std::move(lin->B);
+  chain.joined = std::move(lin->joined);
+  const int columns = chain.start[n];
   // Jacobi scaling: the sweeps run on W H W (unit diagonal), so that the rank test compares like
   // with like whatever the units (metres, rad/s of a bias).
   chain.w.resize(columns);

@@ -15,6 +15,9 @@ RunConfig LoadRunConfig(const std::string& path) {
   if (e.max_solver_iterations < 1) est.Fail("max_solver_iterations", "must be at least 1");
   e.max_solver_time_s = est.GetNonNegative("max_solver_time_s", e.max_solver_time_s);
   e.solver_cost_tolerance = est.GetNonNegative("solver_cost_tolerance", e.solver_cost_tolerance);
+  e.chain_solver = est.GetBool("chain_solver", e.chain_solver);
+  e.solver_initial_damping =
+      est.GetPositive("solver_initial_damping", e.solver_initial_damping);
   e.vision.huber_sigmas = est.GetPositive("huber_sigmas", e.vision.huber_sigmas);
   e.mono_gate_chi2 = est.GetNonNegative("mono_gate_chi2", e.mono_gate_chi2);
   e.stereo_gate_chi2 = est.GetNonNegative("stereo_gate_chi2", e.stereo_gate_chi2);

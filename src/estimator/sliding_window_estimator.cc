@@ -13,6 +13,7 @@
 #include <ceres/solver.h>
 
 #include "auvdock/estimator/chain_marginals.h"
+#include "auvdock/estimator/chain_solver.h"
 #include "auvdock/estimator/marginal_covariance.h"
 #include "auvdock/estimator/marginalization.h"
 #include "auvdock/estimator/sensor_factors.h"
@@ -291,6 +292,16 @@ bool SlidingWindowEstimator::AddState(int64_t t_ns) {
 }
 
 bool SlidingWindowEstimator::Solve(bool stop_early) {
+  if (options_.chain_solver) {
+    ChainSolverOptions chain;
+    chain.max_iterations = options_.max_solver_iterations;
+    chain.max_time_s = options_.max_solver_time_s;
+    chain.initial_lambda = options_.solver_initial_damping;
+    if (stop_early) chain.cost_change_tolerance = options_.solver_cost_tolerance;
+    const std::optional<ChainSolverSummary> summary =
+        SolveChain(problem_.get(), StateBlocksInOrder(), chain);
+    if (summary) return summary->usable;  // else not a chain: Ceres below
+  }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
@@ -619,6 +630,13 @@ void SlidingWindowEstimator::MarginalizeOldest() {
   }
 }
 
+std::vector<std::vector<double*>> SlidingWindowEstimator::StateBlocksInOrder() const {
+  std::vector<std::vector<double*>> states;
+  states.reserve(window_.size());
+  for (const auto& s : window_) states.push_back({s->pose, s->velocity, s->bias});
+  return states;
+}
+
 std::optional<Eigen::MatrixXd> SlidingWindowEstimator::PoseCovariance(const State& state,
                                                                       std::string* reason) {
   if (&state != window_.back().get()) {
@@ -626,9 +644,8 @@ std::optional<Eigen::MatrixXd> SlidingWindowEstimator::PoseCovariance(const Stat
   }
   // The window is a chain (IMU factors between neighbours, every other factor on one state, the
   // marginalisation prior on the oldest): the forward sweep gives the newest state's marginal.
-  std::vector<std::vector<double*>> states;
-  for (const auto& s : window_) states.push_back({s->pose, s->velocity, s->bias});
-  const std::optional<LastStateMarginal> last = ChainMarginalOfLast(problem_.get(), states);
+  const std::optional<LastStateMarginal> last =
+      ChainMarginalOfLast(problem_.get(), StateBlocksInOrder());
   if (!last) return MarginalCovariance(problem_.get(), state.pose, {}, reason);
   if (!last->covariance) {
     *reason = "rank-deficient information (an unobserved direction)";

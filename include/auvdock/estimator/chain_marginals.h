@@ -3,10 +3,10 @@
 // time, as in the batch smoother (IMU factors between consecutive states; every vision, depth,
 // DVL, USBL and prior factor on one state).
 //
-// Math. With the tangent-space Jacobian J of every residual block at the current values
-// (Problem::Evaluate, robust losses applied as Ceres' corrector does; as in
-// marginal_covariance.h), the Gauss-Newton information H = J^T J of a chain is block-
-// tridiagonal: diagonal blocks D_k (state k with itself), off-diagonal blocks B_k = H_{k,k+1}.
+// Math. With the tangent-space Jacobian J of every residual block at the current values (robust
+// losses applied as Ceres' corrector does; chain_linearization.h), the Gauss-Newton information
+// H = J^T J of a chain is block-tridiagonal: diagonal blocks D_k (state k with itself),
+// off-diagonal blocks B_k = H_{k,k+1}.
 // The diagonal blocks of H^-1 follow from two sweeps (the block-tridiagonal inverse; the
 // information form of a Rauch-Tung-Striebel smoother):
 //   forward:   S_0 = D_0,   S_k = D_k - B_{k-1}^T S_{k-1}^-1 B_{k-1}
@@ -24,8 +24,8 @@
 // information form of a filter's update), O(n) with a small constant (the sliding window's
 // newest-pose covariance, every frame).
 //
-// H is accumulated straight into the blocks D_k and B_k, one residual block's rows at a time (they
-// touch one state or two neighbours), without forming J^T J as a general sparse product.
+// H is accumulated straight into the blocks D_k and B_k, one residual block at a time
+// (chain_linearization.h), without forming J^T J as a general sparse product.
 //
 // Segments: B_k = 0 where no factor joins states k and k+1 (an IMU gap); the sweeps then treat
 // the two parts independently. Rank deficiency: a scaled S_k whose smallest pivot (of its

@@ -89,12 +89,28 @@ struct EstimatorOptions {
   double max_solver_time_s = 0.0;        // per solve; 0 = no time limit (deterministic)
   // A solve stops once a successful step lowers the cost (1/2 chi^2) by less than this, an
   // absolute amount. Its warm start (the IMU's prediction for the newest state, the last
-  // solution for the others) is close, but its convergence is only linear (robust losses, the
-  // marginalisation prior fixed at its linearisation point): Ceres' relative tolerance (1e-6 of
-  // a cost of ~25) took 6 steps a frame on the default run, the last ones moving the estimate by
-  // a hundredth of its standard deviation. A step that lowers the cost by d moves the estimate
-  // by a Mahalanobis length of about sqrt(2 d): 0.14 sigma at 0.01. 0: Ceres' tolerances only.
+  // solution for the others) is close: Ceres' relative tolerance (1e-6 of a cost of ~25) took 6
+  // steps a frame on the default run, the last ones moving the estimate by a hundredth of its
+  // standard deviation (most of those steps were spent shrinking the damping: see
+  // solver_initial_damping). A step that lowers the cost by d moves the estimate
+  // by a Mahalanobis length of about sqrt(2 d): 0.14 sigma at 0.01. 0: the solver's relative
+  // tolerance (1e-6 of the cost) alone.
   double solver_cost_tolerance = 0.01;
+  // Solve the window's chain (IMU factors between neighbours, every other factor on one state)
+  // with its own block-tridiagonal Levenberg-Marquardt (chain_solver.h) instead of Ceres'
+  // sparse Cholesky; Ceres solves whatever is not such a chain. The same minimum, faster (see
+  // chain_solver.h). false: Ceres always (for comparison).
+  bool chain_solver = true;
+  // The chain solver's first Levenberg-Marquardt damping lambda of each solve (chain_solver.h;
+  // relative to the information's diagonal), Ceres' own start (its trust region's radius 1e4):
+  // the chain solver then takes Ceres' steps and gives its estimates. Most of a solve's steps
+  // shrink lambda at ~0.1 of cost each until the Gauss-Newton step moves along the weakly
+  // observed directions (the biases early in a run; the height with one light in view and no
+  // depth sensor). A smaller start (1e-8) converges in 2 steps instead of 6 and is as accurate
+  // wherever the depth sensor or the DVL observes those directions, but with vision and IMU
+  // alone the converged window drifts further along them (the damping had held them at the
+  // IMU's prediction): measured in the README ("Speed").
+  double solver_initial_damping = 1e-4;
   VisionFactorOptions vision;           // mono/stereo on/off, Huber threshold, stage weights
   // Chi-square gates on the squared Mahalanobis distance of each vision residual after the
   // solve (p = 0.999: 13.82 for a pixel pair, 16.27 for a 3-D point); 0 = no gating.
@@ -371,8 +387,11 @@ class SlidingWindowEstimator {
   void StartWindow(const InitialState& initial);
   void Reset(const std::string& reason);
   bool AddState(int64_t t_ns);
-  // stop_early: stop once a step lowers the cost by less than solver_cost_tolerance.
+  // stop_early: stop once a step lowers the cost by less than solver_cost_tolerance. The chain
+  // solver when the window is a chain and chain_solver is on, Ceres otherwise.
   bool Solve(bool stop_early = true);
+  // Each window state's blocks (pose, velocity, bias), oldest first.
+  std::vector<std::vector<double*>> StateBlocksInOrder() const;
   void MarginalizeOldest();
   // The pending depth samples up to t_ns onto the states at or before them; returns the
   // residuals added.
