@@ -15,6 +15,7 @@
 #include <ceres/solver.h>
 
 #include "auvdock/estimator/chain_marginals.h"
+#include "auvdock/estimator/chain_solver.h"
 #include "auvdock/estimator/sensor_factors.h"
 #include "auvdock/estimator/imu_buffer.h"
 #include "auvdock/estimator/vision_factors.h"
@@ -48,6 +49,52 @@ class ProgressCallback final : public ceres::IterationCallback {
  private:
   const std::function<void(int, double)>& progress_;
 };
+
+// What the batch reports of a solve.
+struct BatchSolve {
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  int iterations = 0;  // counting the evaluation at the start, as Ceres does
+  bool converged = false;
+};
+
+// The batch is a chain (IMU factors between neighbours, every other factor on one state): the
+// chain solver (chain_solver.h) at Ceres' tolerances and damping takes Ceres' steps without its
+// general sparse Cholesky; Ceres solves anything else, or everything with chain_solver off.
+BatchSolve SolveBatch(ceres::Problem* problem, const std::vector<std::unique_ptr<BatchState>>& states,
+                      const ceres::Solver::Options& solver, const EstimatorOptions& o,
+                      const std::function<void(int, double)>& progress) {
+  BatchSolve result;
+  if (o.chain_solver) {
+    ChainSolverOptions chain;
+    chain.max_iterations = solver.max_num_iterations;
+    chain.function_tolerance = solver.function_tolerance;
+    chain.gradient_tolerance = solver.gradient_tolerance;
+    chain.parameter_tolerance = solver.parameter_tolerance;
+    chain.initial_lambda = o.solver_initial_damping;
+    chain.progress = progress;
+    std::vector<std::vector<double*>> blocks;
+    blocks.reserve(states.size());
+    for (const auto& s : states) blocks.push_back({s->pose, s->velocity, s->bias});
+    if (const std::optional<ChainSolverSummary> summary = SolveChain(problem, blocks, chain)) {
+      result.initial_cost = summary->initial_cost;
+      result.final_cost = summary->final_cost;
+      result.iterations = summary->iterations + 1;
+      result.converged = summary->converged;
+      return result;
+    }
+  }
+  ceres::Solver::Options options = solver;
+  ProgressCallback callback(progress);
+  options.callbacks.push_back(&callback);
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, problem, &summary);
+  result.initial_cost = summary.initial_cost;
+  result.final_cost = summary.final_cost;
+  result.iterations = static_cast<int>(summary.iterations.size());
+  result.converged = summary.termination_type == ceres::CONVERGENCE;
+  return result;
+}
 
 void AddInitialPriors(ceres::Problem* problem, const EstimatorOptions& o, BatchState* s) {
   Matrix6d pose_cov = Matrix6d::Zero();
@@ -326,8 +373,6 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   solver.max_num_iterations = options.information_at_warm_start ? 0 : options.max_iterations;
   solver.num_threads = 1;
   solver.logging_type = ceres::SILENT;
-  ProgressCallback callback(options.progress);
-  solver.callbacks.push_back(&callback);
   // The navigation sensors are gated twice: at the warm start (the window's estimate, good
   // enough to tell a DVL spike of 0.3 m/s from 1 cm/s noise) before the solve, so that spikes
   // without a robust loss do not pull the whole batch and drag clean samples past the gate with
@@ -360,8 +405,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     return gate(&sbl_residuals, estimator_options.sbl_gate_chi2, calibration.sbl);
   };
   result.stats.sbl_gated = gate_sbl();
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver, &problem, &summary);
+  BatchSolve summary = SolveBatch(&problem, states, solver, estimator_options, options.progress);
   result.initial_cost = summary.initial_cost;
   int gated = 0;
   for (auto& s : states) {
@@ -387,7 +431,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   result.stats.sbl_used = static_cast<int>(sbl_residuals.size());
   if (gated > 0 || depth_gated_after > 0 || dvl_gated_after > 0 || usbl_gated_after > 0 ||
       sbl_gated_after > 0 || heading_gated_after > 0) {
-    ceres::Solve(solver, &problem, &summary);
+    summary = SolveBatch(&problem, states, solver, estimator_options, options.progress);
   }
   std::stable_sort(result.rejections.begin(), result.rejections.end(),
                    [](const Rejection& a, const Rejection& b) { return a.t_ns < b.t_ns; });
@@ -399,8 +443,8 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
         problem, all_vision, static_cast<int64_t>(1.5e9 * interval_s));
   }
   result.final_cost = summary.final_cost;
-  result.iterations = static_cast<int>(summary.iterations.size());
-  result.converged = summary.termination_type == ceres::CONVERGENCE;
+  result.iterations = summary.iterations;
+  result.converged = summary.converged;
 
   const std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> pose_covariances =
       PoseMarginals(&problem, states);

@@ -142,6 +142,7 @@ std::optional<ChainSolverSummary> SolveChain(ceres::Problem* problem,
   double growth = 2.0;
   Eigen::VectorXd delta;
   summary.termination = "maximum number of iterations";
+  if (options.progress) options.progress(0, cost);
   while (true) {
     if (lin->gradient.size() == 0 ||
         lin->gradient.cwiseAbs().maxCoeff() <= options.gradient_tolerance) {
@@ -181,6 +182,7 @@ std::optional<ChainSolverSummary> SolveChain(ceres::Problem* problem,
       }
       if (!kept) restore();
     }
+    if (options.progress) options.progress(summary.iterations, kept ? cost - decrease : cost);
     if (!kept) {
       lambda *= growth;
       growth *= 2.0;
@@ -207,6 +209,9 @@ std::optional<ChainSolverSummary> SolveChain(ceres::Problem* problem,
   }
   summary.final_cost = cost;
   summary.usable = std::isfinite(cost);
+  summary.converged = summary.termination == "gradient tolerance" ||
+                      summary.termination == "parameter tolerance" ||
+                      summary.termination == "cost change below tolerance";
   for (const ChainBlock& b : blocks) {
     if (!std::all_of(b.values, b.values + b.ambient, [](double v) { return std::isfinite(v); })) {
       summary.usable = false;

@@ -1,5 +1,7 @@
 // Batch smoother for offline trajectory reconstruction: every state of a whole log in one sparse
-// Ceres problem (SuiteSparse Cholesky), the same factors as the sliding window
+// Ceres problem, solved as a chain (estimator/chain_solver.h: block-tridiagonal Levenberg-
+// Marquardt, Ceres' steps at Ceres' tolerances; Ceres' SuiteSparse Cholesky when the problem is
+// not a chain or EstimatorOptions::chain_solver is off), the same factors as the sliding window
 // (estimator/vision_factors.h, IMU preintegration, initial priors) but nothing marginalized, so
 // every state sees all the data before and after it.
 //

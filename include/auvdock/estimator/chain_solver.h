@@ -3,7 +3,7 @@
 // tridiagonal factorisation of their information instead of a general sparse Cholesky.
 //
 // Why: the sliding window's problem is a chain of ~10 states of 15 tangent coordinates (pose 6,
-// velocity 3, biases 6). Ceres' SPARSE_NORMAL_CHOLESKY forms J^T J as a general sparse product
+// velocity 3, biases 6), the batch smoother's a chain of the whole log's states. Ceres' SPARSE_NORMAL_CHOLESKY forms J^T J as a general sparse product
 // and hands it to CHOLMOD, whose set-up dominates at this size (39 % of the window's update on
 // 2026-12-06's profile); the chain's own factorisation costs O(n 15^3) and its blocks come
 // straight from the residual blocks.
@@ -32,6 +32,7 @@
 // Units: those of the problem's tangent spaces.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -52,6 +53,9 @@ struct ChainSolverOptions {
   double min_relative_decrease = 1e-3;
   double min_diagonal = 1e-6;
   double max_diagonal = 1e32;
+  // Called with (iteration, cost) at the start (iteration 0) and after every step tried, as
+  // Ceres' iteration callbacks are.
+  std::function<void(int, double)> progress;
 };
 
 struct ChainSolverSummary {
@@ -61,6 +65,7 @@ struct ChainSolverSummary {
   double initial_cost = 0.0;
   double final_cost = 0.0;
   std::string termination;  // why it stopped
+  bool converged = false;   // by a tolerance (not the iteration or time limit, nor a failure)
 };
 
 // Minimises the problem over the states' blocks (chain order), starting from their values; the
