@@ -105,7 +105,7 @@ std::optional<ChainSolverSummary> SolveChain(ceres::Problem* problem,
       ambient_size += info.ambient;
     }
   }
-  std::vector<double> saved(ambient_size), trial;
+  std::vector<double> saved(ambient_size);
   auto save = [&]() {
     int at = 0;
     for (const ChainBlock& b : blocks) {
