@@ -58,38 +58,46 @@ std::optional<ScaledChain> AssembleScaledChain(ceres::Problem* problem,
   return chain;
 }
 
-// The forward sweep: S_k^-1 for every state, each state's segment (states joined by factors)
-// and whether that segment is of full rank.
+// The forward sweep: G_k = S_k^-1 B_k for every joined state, S_k^-1 for every state (or the
+// last only: all_inverses false), each state's segment (states joined by factors) and whether
+// that segment is of full rank. A rank-deficient S_k leaves G_k and S_k^-1 zero (which keeps
+// the sweep finite).
 struct ForwardSweep {
-  std::vector<Eigen::MatrixXd> S_inv;
+  std::vector<Eigen::MatrixXd> S_inv, G;
   std::vector<int> segment;
   std::vector<bool> segment_ok;
 };
 
-ForwardSweep SweepForward(const ScaledChain& chain, const ChainMarginalsOptions& options) {
+ForwardSweep SweepForward(const ScaledChain& chain, const ChainMarginalsOptions& options,
+                          bool all_inverses) {
   const int n = static_cast<int>(chain.D.size());
   ForwardSweep sweep;
   sweep.S_inv.resize(n);
+  sweep.G.resize(n);
   sweep.segment.assign(n, 0);
   sweep.segment_ok.assign(1, true);
   for (int k = 0; k < n; ++k) {
     Eigen::MatrixXd S = chain.D[k];
     if (k > 0 && chain.joined[k - 1]) {
       sweep.segment[k] = sweep.segment[k - 1];
-      S -= chain.B[k - 1].transpose() * sweep.S_inv[k - 1] * chain.B[k - 1];
+      S.noalias() -= chain.B[k - 1].transpose() * sweep.G[k - 1];
     } else if (k > 0) {
       sweep.segment[k] = sweep.segment[k - 1] + 1;
       sweep.segment_ok.push_back(true);
     }
     S = 0.5 * (S + S.transpose()).eval();
+    const bool joined_next = k + 1 < n && chain.joined[k];
+    const bool inverse = all_inverses || k + 1 == n;
     const Eigen::LDLT<Eigen::MatrixXd> ldlt(S);
     if (ldlt.info() != Eigen::Success || !ldlt.isPositive() ||
         !(ldlt.vectorD().minCoeff() > options.min_pivot)) {
       sweep.segment_ok[sweep.segment[k]] = false;
-      sweep.S_inv[k] = Eigen::MatrixXd::Zero(S.rows(), S.cols());  // keeps the sweep finite
+      if (inverse) sweep.S_inv[k] = Eigen::MatrixXd::Zero(S.rows(), S.cols());
+      if (joined_next) sweep.G[k] = Eigen::MatrixXd::Zero(chain.B[k].rows(), chain.B[k].cols());
       continue;
     }
-    sweep.S_inv[k] = ldlt.solve(Eigen::MatrixXd::Identity(S.rows(), S.cols()));
+    if (inverse) sweep.S_inv[k] = ldlt.solve(Eigen::MatrixXd::Identity(S.rows(), S.cols()));
+    if (joined_next) sweep.G[k] = ldlt.solve(chain.B[k]);
   }
   return sweep;
 }
@@ -113,13 +121,13 @@ std::optional<std::vector<std::optional<Eigen::MatrixXd>>> ChainMarginals(
   const int n = static_cast<int>(states.size());
   std::vector<std::optional<Eigen::MatrixXd>> marginals(n);
   if (n == 0) return marginals;
-  const ForwardSweep sweep = SweepForward(*chain, options);
+  const ForwardSweep sweep = SweepForward(*chain, options, /*all_inverses=*/true);
   // Backward: the marginals.
   Eigen::MatrixXd next;
   for (int k = n - 1; k >= 0; --k) {
     Eigen::MatrixXd sigma = sweep.S_inv[k];
     if (k + 1 < n && chain->joined[k]) {
-      const Eigen::MatrixXd G = sweep.S_inv[k] * chain->B[k];
+      const Eigen::MatrixXd& G = sweep.G[k];
       sigma += G * next * G.transpose();
     }
     sigma = 0.5 * (sigma + sigma.transpose()).eval();
@@ -135,7 +143,7 @@ std::optional<LastStateMarginal> ChainMarginalOfLast(
   if (states.empty()) throw std::invalid_argument("ChainMarginalOfLast: no state");
   const std::optional<ScaledChain> chain = AssembleScaledChain(problem, states);
   if (!chain) return std::nullopt;
-  const ForwardSweep sweep = SweepForward(*chain, options);
+  const ForwardSweep sweep = SweepForward(*chain, options, /*all_inverses=*/false);
   const int last = static_cast<int>(states.size()) - 1;
   LastStateMarginal result;
   if (sweep.segment_ok[sweep.segment[last]]) {
