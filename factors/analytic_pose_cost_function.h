@@ -24,11 +24,13 @@
 #include <Eigen/Core>
 
 #include "factors/pose_manifold.h"
+#include "factors/tangent_jacobians.h"
 
 namespace auvdock {
 
 template <typename Factor, int kResiduals>
-class AnalyticPoseCostFunction : public ceres::SizedCostFunction<kResiduals, kPoseSize> {
+class AnalyticPoseCostFunction : public ceres::SizedCostFunction<kResiduals, kPoseSize>,
+                                 public TangentJacobians {
  public:
   using TangentJacobian = Eigen::Matrix<double, kResiduals, kPoseTangentSize, Eigen::RowMajor>;
 
@@ -47,6 +49,19 @@ class AnalyticPoseCostFunction : public ceres::SizedCostFunction<kResiduals, kPo
     Eigen::Map<Eigen::Matrix<double, kResiduals, kPoseSize, Eigen::RowMajor>> ambient(
         jacobians[0]);
     ambient = J * lift;
+    return true;
+  }
+
+  // J_tangent as the factor gives it, not lifted (tangent_jacobians.h).
+  bool EvaluateInTangentSpace(double const* const* parameters, double* residuals,
+                              double** jacobians) const override {
+    if (jacobians == nullptr || jacobians[0] == nullptr) {
+      return factor_->EvaluateTangent(parameters[0], residuals, nullptr);
+    }
+    TangentJacobian J;
+    if (!factor_->EvaluateTangent(parameters[0], residuals, &J)) return false;
+    Eigen::Map<TangentJacobian> out(jacobians[0]);
+    out = J;
     return true;
   }
 

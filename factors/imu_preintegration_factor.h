@@ -50,6 +50,7 @@
 #include "auvdock/geometry/so3.h"
 #include "auvdock/imu/imu_preintegration.h"
 #include "factors/pose_manifold.h"
+#include "factors/tangent_jacobians.h"
 
 namespace auvdock {
 
@@ -57,7 +58,8 @@ inline constexpr int kImuResidualSize = 15;
 
 class ImuPreintegrationFactor final
     : public ceres::SizedCostFunction<15, kPoseSize, kVelocitySize, kBiasSize, kPoseSize,
-                                      kVelocitySize, kBiasSize> {
+                                      kVelocitySize, kBiasSize>,
+      public TangentJacobians {
  public:
   using Vector15 = Eigen::Matrix<double, kImuResidualSize, 1>;
   using Matrix15 = Eigen::Matrix<double, kImuResidualSize, kImuResidualSize>;
@@ -117,6 +119,21 @@ class ImuPreintegrationFactor final
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
+    return EvaluateImpl(parameters, residuals, jacobians, /*tangent=*/false);
+  }
+  // The pose blocks' Jacobians in their tangent space (15 x 6), not lifted (tangent_jacobians.h).
+  bool EvaluateInTangentSpace(double const* const* parameters, double* residuals,
+                              double** jacobians) const override {
+    return EvaluateImpl(parameters, residuals, jacobians, /*tangent=*/true);
+  }
+
+  const ImuPreintegration& preintegration() const { return preintegration_; }
+  const Eigen::Vector3d& gravity_D() const { return gravity_D_; }
+  const Matrix15& covariance() const { return covariance_; }
+
+ private:
+  bool EvaluateImpl(double const* const* parameters, double* residuals, double** jacobians,
+                    bool tangent) const {
     using Eigen::Matrix3d;
     using Eigen::Vector3d;
     const Eigen::Map<const Vector3d> p_i(parameters[0]);
@@ -157,8 +174,15 @@ class ImuPreintegrationFactor final
     const Matrix3d I = Matrix3d::Identity();
     using Matrix15x6 = Eigen::Matrix<double, kImuResidualSize, 6>;
     using Matrix15x3 = Eigen::Matrix<double, kImuResidualSize, 3>;
-    // Pose blocks: tangent (dp, dtheta) Jacobian, whitened, then lifted to the 7 ambient numbers.
+    // Pose blocks: tangent (dp, dtheta) Jacobian, whitened, then lifted to the 7 ambient numbers
+    // (or left in the tangent space).
     auto write_pose = [&](const Matrix15x6& J_tangent, const double* pose, double* out) {
+      if (tangent) {
+        Eigen::Map<Eigen::Matrix<double, kImuResidualSize, kPoseTangentSize, Eigen::RowMajor>>
+            J_out(out);
+        J_out = L * J_tangent;
+        return;
+      }
       Eigen::Matrix<double, kPoseTangentSize, kPoseSize, Eigen::RowMajor> lift;
       PoseManifold().MinusJacobian(pose, lift.data());
       Eigen::Map<Eigen::Matrix<double, kImuResidualSize, kPoseSize, Eigen::RowMajor>> J_out(out);
@@ -215,9 +239,7 @@ class ImuPreintegrationFactor final
     return true;
   }
 
-  const ImuPreintegration& preintegration() const { return preintegration_; }
-  const Eigen::Vector3d& gravity_D() const { return gravity_D_; }
-  const Matrix15& covariance() const { return covariance_; }
+ public:
   const Matrix15& sqrt_information() const { return sqrt_info_; }
 
  private:

@@ -7,6 +7,8 @@
 #include <ceres/cost_function.h>
 #include <ceres/loss_function.h>
 
+#include "factors/tangent_jacobians.h"
+
 namespace auvdock {
 namespace {
 
@@ -101,6 +103,7 @@ std::optional<ChainLinearization> LinearizeChain(const ceres::Problem& problem,
     problem.GetParameterBlocksForResidualBlock(id, &parameters);
     const int m = cost->num_residuals();
     const int p = static_cast<int>(parameters.size());
+    const auto* in_tangent_space = dynamic_cast<const TangentJacobians*>(cost);
     ambient.resize(p);
     ambient_pointers.resize(p);
     infos.resize(p);
@@ -111,19 +114,28 @@ std::optional<ChainLinearization> LinearizeChain(const ceres::Problem& problem,
       infos[i] = &it->second;
       k_min = std::min(k_min, infos[i]->state);
       k_max = std::max(k_max, infos[i]->state);
-      ambient[i].resize(m, infos[i]->ambient);
+      ambient[i].resize(m, in_tangent_space != nullptr ? infos[i]->tangent : infos[i]->ambient);
       ambient_pointers[i] = ambient[i].data();
     }
     if (k_max - k_min > 1) return std::nullopt;  // not a chain
     r.resize(m);
-    if (!cost->Evaluate(parameters.data(), r.data(), ambient_pointers.data())) return std::nullopt;
-    // The block's tangent Jacobian, all its parameter blocks side by side (J~ below).
+    // The block's tangent Jacobian, all its parameter blocks side by side (J~ below): straight
+    // from a cost function that gives it (tangent_jacobians.h), else its ambient Jacobian times
+    // each block's PlusJacobian.
     int width = 0;
     for (int i = 0; i < p; ++i) width += infos[i]->tangent;
     J.resize(m, width);
+    if (in_tangent_space != nullptr) {
+      if (!in_tangent_space->EvaluateInTangentSpace(parameters.data(), r.data(),
+                                                    ambient_pointers.data())) {
+        return std::nullopt;
+      }
+    } else if (!cost->Evaluate(parameters.data(), r.data(), ambient_pointers.data())) {
+      return std::nullopt;
+    }
     for (int i = 0, column = 0; i < p; ++i) {
       auto Ji = J.middleCols(column, infos[i]->tangent);
-      if (infos[i]->manifold == nullptr) {
+      if (in_tangent_space != nullptr || infos[i]->manifold == nullptr) {
         Ji = ambient[i];
       } else {
         Ji.noalias() = ambient[i].lazyProduct(plus_jacobians.at(parameters[i]));

@@ -233,6 +233,52 @@ TEST(ImuPreintegrationFactor, AnalyticJacobiansEqualAutoDiff) {
   }
 }
 
+// The Jacobians in the tangent spaces (tangent_jacobians.h, for the chain solver) are the ambient
+// ones times each block's PlusJacobian, and the residuals the same.
+TEST(ImuPreintegrationFactor, TangentSpaceJacobiansAreTheAmbientOnesProjected) {
+  std::mt19937_64 rng(13);
+  const ImuPreintegration pim = MakePreintegration(rng);
+  const std::unique_ptr<ceres::CostFunction> factor(
+      ImuPreintegrationFactor::Create(pim, kGravity_D));
+  const auto* in_tangent = dynamic_cast<const TangentJacobians*>(factor.get());
+  ASSERT_NE(in_tangent, nullptr);
+  const int ambient[] = {kPoseSize, kVelocitySize, kBiasSize, kPoseSize, kVelocitySize, kBiasSize};
+  const int tangent[] = {kPoseTangentSize, kVelocitySize, kBiasSize,
+                         kPoseTangentSize, kVelocitySize, kBiasSize};
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  for (int trial = 0; trial < 10; ++trial) {
+    State i = RandomStateI(rng);
+    State j = PredictedStateJ(pim, i);
+    j.p() += RandomVector(rng, 0.5);
+    j.q() = (QuaternionExp<double>(RandomVector(rng, 0.3)) * j.q()).normalized();
+    const double* parameters[] = {i.pose, i.velocity, i.bias, j.pose, j.velocity, j.bias};
+    std::vector<RowMajor> A(6), T(6);
+    double* a[6];
+    double* t[6];
+    for (int k = 0; k < 6; ++k) {
+      A[k].resize(15, ambient[k]);
+      T[k].resize(15, tangent[k]);
+      a[k] = A[k].data();
+      t[k] = T[k].data();
+    }
+    Eigen::Matrix<double, 15, 1> r_ambient, r_tangent;
+    ASSERT_TRUE(factor->Evaluate(parameters, r_ambient.data(), a));
+    ASSERT_TRUE(in_tangent->EvaluateInTangentSpace(parameters, r_tangent.data(), t));
+    EXPECT_EQ(r_ambient, r_tangent);
+    for (int k = 0; k < 6; ++k) {
+      RowMajor projected = A[k];
+      if (ambient[k] == kPoseSize) {
+        Eigen::Matrix<double, kPoseSize, kPoseTangentSize, Eigen::RowMajor> plus;
+        PoseManifold().PlusJacobian(parameters[k], plus.data());
+        projected = A[k] * plus;
+      }
+      EXPECT_LT((projected - T[k]).cwiseAbs().maxCoeff(),
+                1e-10 * (1.0 + T[k].cwiseAbs().maxCoeff()))
+          << "trial " << trial << ", block " << k;
+    }
+  }
+}
+
 // Hand-worked offsets from the perfect state j: each one moves exactly its own error block, by
 // the amount the formulas say, and the weighted residual is sqrt_info times that error.
 TEST(ImuPreintegrationFactor, HandWorkedOffsetsGiveTheExpectedErrors) {

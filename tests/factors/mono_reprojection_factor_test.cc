@@ -159,6 +159,36 @@ TEST(MonoReprojectionFactorTest, AnalyticJacobianEqualsAutomaticDifferentiation)
   }
 }
 
+// The Jacobian in the pose's tangent space (tangent_jacobians.h, for the chain solver) is the
+// ambient one times the PlusJacobian, and the residual the same.
+TEST(MonoReprojectionFactorTest, TangentSpaceJacobianIsTheAmbientOneProjected) {
+  const PinholeRadtanCamera camera = DistortedCamera();
+  const Pose3 T_B_C = DownLookingExtrinsic();
+  for (const Pose3& T_D_B : TestPoses()) {
+    const Eigen::Vector3d p_D_L = LightAt(T_D_B, T_B_C, Eigen::Vector3d(0.7, -0.5, 1.8));
+    const Eigen::Vector2d uv =
+        ReferencePixel(camera, T_D_B, T_B_C, p_D_L) + Eigen::Vector2d(1.5, -0.8);
+    std::unique_ptr<ceres::CostFunction> factor(MonoReprojectionFactor::Create(
+        std::make_unique<MonoReprojectionFactor>(uv, 0.09 * Eigen::Matrix2d::Identity(), camera,
+                                                 T_B_C, p_D_L, 0.7)));
+    const auto* in_tangent = dynamic_cast<const TangentJacobians*>(factor.get());
+    ASSERT_NE(in_tangent, nullptr);
+    const Vector7 x = ToBlock(T_D_B);
+    const double* parameters[] = {x.data()};
+    Eigen::Matrix<double, 2, kPoseSize, Eigen::RowMajor> A;
+    Eigen::Matrix<double, 2, kPoseTangentSize, Eigen::RowMajor> T;
+    double* a[] = {A.data()};
+    double* t[] = {T.data()};
+    Eigen::Vector2d r_ambient, r_tangent;
+    ASSERT_TRUE(factor->Evaluate(parameters, r_ambient.data(), a));
+    ASSERT_TRUE(in_tangent->EvaluateInTangentSpace(parameters, r_tangent.data(), t));
+    EXPECT_EQ(r_ambient, r_tangent);
+    Eigen::Matrix<double, kPoseSize, kPoseTangentSize, Eigen::RowMajor> plus;
+    PoseManifold().PlusJacobian(x.data(), plus.data());
+    EXPECT_LT((A * plus - T).cwiseAbs().maxCoeff(), 1e-10 * (1.0 + T.cwiseAbs().maxCoeff()));
+  }
+}
+
 // Undistorted pinhole, down-looking camera at the body origin, level body 2 m above a light
 // right below it. Moving the body by dx along the dock's x axis moves the light by -dx in B, i.e.
 // +dx along the image's y axis (image y = -body x): the pixel moves by fy dx / Z in v.
