@@ -50,6 +50,16 @@ class ProgressCallback final : public ceres::IterationCallback {
   const std::function<void(int, double)>& progress_;
 };
 
+// Each state's blocks (pose, velocity, bias), in time order: the chain of chain_solver.h and
+// chain_marginals.h.
+std::vector<std::vector<double*>> ChainBlocks(
+    const std::vector<std::unique_ptr<BatchState>>& states) {
+  std::vector<std::vector<double*>> chain;
+  chain.reserve(states.size());
+  for (const auto& s : states) chain.push_back({s->pose, s->velocity, s->bias});
+  return chain;
+}
+
 // What the batch reports of a solve.
 struct BatchSolve {
   double initial_cost = 0.0;
@@ -61,7 +71,8 @@ struct BatchSolve {
 // The batch is a chain (IMU factors between neighbours, every other factor on one state): the
 // chain solver (chain_solver.h) at Ceres' tolerances and damping takes Ceres' steps without its
 // general sparse Cholesky; Ceres solves anything else, or everything with chain_solver off.
-BatchSolve SolveBatch(ceres::Problem* problem, const std::vector<std::unique_ptr<BatchState>>& states,
+BatchSolve SolveBatch(ceres::Problem* problem,
+                      const std::vector<std::unique_ptr<BatchState>>& states,
                       const ceres::Solver::Options& solver, const EstimatorOptions& o,
                       const std::function<void(int, double)>& progress) {
   BatchSolve result;
@@ -73,10 +84,8 @@ BatchSolve SolveBatch(ceres::Problem* problem, const std::vector<std::unique_ptr
     chain.parameter_tolerance = solver.parameter_tolerance;
     chain.initial_lambda = o.solver_initial_damping;
     chain.progress = progress;
-    std::vector<std::vector<double*>> blocks;
-    blocks.reserve(states.size());
-    for (const auto& s : states) blocks.push_back({s->pose, s->velocity, s->bias});
-    if (const std::optional<ChainSolverSummary> summary = SolveChain(problem, blocks, chain)) {
+    if (const std::optional<ChainSolverSummary> summary =
+            SolveChain(problem, ChainBlocks(states), chain)) {
       result.initial_cost = summary->initial_cost;
       result.final_cost = summary->final_cost;
       result.iterations = summary->iterations + 1;
@@ -138,10 +147,8 @@ double MedianStateInterval(const std::vector<std::unique_ptr<BatchState>>& state
 std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> PoseMarginals(
     ceres::Problem* problem, const std::vector<std::unique_ptr<BatchState>>& states) {
   std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> marginals(states.size());
-  std::vector<std::vector<double*>> chain;
-  for (const auto& s : states) chain.push_back({s->pose, s->velocity, s->bias});
   const std::optional<std::vector<std::optional<Eigen::MatrixXd>>> chain_marginals =
-      ChainMarginals(problem, chain);
+      ChainMarginals(problem, ChainBlocks(states));
   if (chain_marginals &&
       std::all_of(chain_marginals->begin(), chain_marginals->end(),
                   [](const std::optional<Eigen::MatrixXd>& m) { return m.has_value(); })) {

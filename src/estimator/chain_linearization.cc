@@ -81,14 +81,19 @@ std::optional<ChainLinearization> LinearizeChain(const ceres::Problem& problem,
     lin.D[k] = Eigen::MatrixXd::Zero(layout.state_size(k), layout.state_size(k));
     if (k + 1 < n) lin.B[k] = Eigen::MatrixXd::Zero(layout.state_size(k), layout.state_size(k + 1));
   }
-  // Each block's dPlus/ddelta at its current value (ambient x tangent), once.
+  // A block's dPlus/ddelta at its current value (ambient x tangent), computed when a cost
+  // function without tangent-space Jacobians first needs it (a prior on a pose), then kept.
   std::unordered_map<const double*, RowMajorMatrix> plus_jacobians;
-  for (const auto& [block, info] : layout.blocks) {
-    if (info.manifold == nullptr) continue;
-    RowMajorMatrix P(info.ambient, info.tangent);
-    if (!info.manifold->PlusJacobian(block, P.data())) return std::nullopt;
-    plus_jacobians.emplace(block, std::move(P));
-  }
+  const auto plus_jacobian = [&](const double* block,
+                                 const ChainLayout::Block& info) -> const RowMajorMatrix* {
+    auto it = plus_jacobians.find(block);
+    if (it == plus_jacobians.end()) {
+      RowMajorMatrix P(info.ambient, info.tangent);
+      if (!info.manifold->PlusJacobian(block, P.data())) return nullptr;
+      it = plus_jacobians.emplace(block, std::move(P)).first;
+    }
+    return &it->second;
+  };
 
   std::vector<ceres::ResidualBlockId> ids;
   problem.GetResidualBlocks(&ids);
@@ -138,7 +143,9 @@ std::optional<ChainLinearization> LinearizeChain(const ceres::Problem& problem,
       if (in_tangent_space != nullptr || infos[i]->manifold == nullptr) {
         Ji = ambient[i];
       } else {
-        Ji.noalias() = ambient[i].lazyProduct(plus_jacobians.at(parameters[i]));
+        const RowMajorMatrix* P = plus_jacobian(parameters[i], *infos[i]);
+        if (P == nullptr) return std::nullopt;
+        Ji.noalias() = ambient[i].lazyProduct(*P);
       }
       column += infos[i]->tangent;
     }
