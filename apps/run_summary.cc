@@ -1,6 +1,7 @@
 #include "apps/run_summary.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace auvdock::cli {
@@ -48,6 +49,15 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                                 {"gated", stats.heading_gated},
                                 {"skipped", stats.heading_skipped}};
   summary["acoustic_starts"] = stats.acoustic_starts;
+  if (std::isfinite(stats.depth_offset_m)) {
+    // estimate_depth_offset: the depth sensor's offset at the last estimate (sigma null when
+    // its covariance was not computed).
+    summary["depth_offset"] = {
+        {"m", stats.depth_offset_m},
+        {"sigma_m", std::isfinite(stats.depth_offset_sigma_m)
+                        ? nlohmann::json(stats.depth_offset_sigma_m)
+                        : nlohmann::json(nullptr)}};
+  }
   summary["no_vision_reasons"] = source.no_vision_reasons();
   if (source.replaying()) {
     const VisionFrameSource::GivenIdentityCounts& given = source.given_identities();

@@ -7,6 +7,7 @@
 // marginal in the full problem, so it uses data before and after the pose.
 #include <chrono>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <set>
 
@@ -131,6 +132,10 @@ void Smooth(const SmoothOptions& options) {
   stats.sbl_used = result.stats.sbl_used;
   stats.sbl_gated = result.stats.sbl_gated;
   stats.sbl_skipped = result.stats.sbl_skipped;
+  // The batch's own offset at the log's end (its sigma is not computed: null).
+  stats.depth_offset_m = result.outputs.empty() ? std::numeric_limits<double>::quiet_NaN()
+                                                : result.outputs.back().depth_offset_m;
+  stats.depth_offset_sigma_m = std::numeric_limits<double>::quiet_NaN();
   nlohmann::json summary = MakeRunSummary(source, stats, skipped_rows, counters);
   summary["batch"] = {{"segments", result.segments},
                       {"iterations", result.iterations},

@@ -22,7 +22,9 @@
 #include "factors/bias_prior_factor.h"
 #include "factors/imu_preintegration_factor.h"
 #include "factors/pose_manifold.h"
+#include "factors/depth_offset_factor.h"
 #include "factors/pose_prior_factor.h"
+#include "factors/scalar_random_walk_factor.h"
 #include "factors/velocity_prior_factor.h"
 
 namespace auvdock {
@@ -33,6 +35,7 @@ struct BatchState {
   double pose[kPoseSize];
   double velocity[kVelocitySize];
   double bias[kBiasSize];
+  double depth_offset[kDepthOffsetSize] = {0.0};  // m; a block only with estimate_depth_offset
   std::vector<VisionResidual> vision;
   int n_gated = 0;
 };
@@ -50,13 +53,16 @@ class ProgressCallback final : public ceres::IterationCallback {
   const std::function<void(int, double)>& progress_;
 };
 
-// Each state's blocks (pose, velocity, bias), in time order: the chain of chain_solver.h and
-// chain_marginals.h.
+// Each state's blocks (pose, velocity, bias, and the depth offset when it is estimated), in
+// time order: the chain of chain_solver.h and chain_marginals.h.
 std::vector<std::vector<double*>> ChainBlocks(
-    const std::vector<std::unique_ptr<BatchState>>& states) {
+    const std::vector<std::unique_ptr<BatchState>>& states, bool with_depth_offset) {
   std::vector<std::vector<double*>> chain;
   chain.reserve(states.size());
-  for (const auto& s : states) chain.push_back({s->pose, s->velocity, s->bias});
+  for (const auto& s : states) {
+    chain.push_back({s->pose, s->velocity, s->bias});
+    if (with_depth_offset) chain.back().push_back(s->depth_offset);
+  }
   return chain;
 }
 
@@ -73,7 +79,8 @@ struct BatchSolve {
 // general sparse Cholesky; Ceres solves anything else, or everything with chain_solver off.
 BatchSolve SolveBatch(ceres::Problem* problem,
                       const std::vector<std::unique_ptr<BatchState>>& states,
-                      const ceres::Solver::Options& solver, const EstimatorOptions& o,
+                      bool with_depth_offset, const ceres::Solver::Options& solver,
+                      const EstimatorOptions& o,
                       const std::function<void(int, double)>& progress) {
   BatchSolve result;
   if (o.chain_solver) {
@@ -85,7 +92,7 @@ BatchSolve SolveBatch(ceres::Problem* problem,
     chain.initial_lambda = o.solver_initial_damping;
     chain.progress = progress;
     if (const std::optional<ChainSolverSummary> summary =
-            SolveChain(problem, ChainBlocks(states), chain)) {
+            SolveChain(problem, ChainBlocks(states, with_depth_offset), chain)) {
       result.initial_cost = summary->initial_cost;
       result.final_cost = summary->final_cost;
       result.iterations = summary->iterations + 1;
@@ -145,10 +152,11 @@ double MedianStateInterval(const std::vector<std::unique_ptr<BatchState>>& state
 // long stretch on the IMU alone can leave a legitimately small information at rounding level
 // there; the QR of J decides.
 std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> PoseMarginals(
-    ceres::Problem* problem, const std::vector<std::unique_ptr<BatchState>>& states) {
+    ceres::Problem* problem, const std::vector<std::unique_ptr<BatchState>>& states,
+    bool with_depth_offset) {
   std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> marginals(states.size());
   const std::optional<std::vector<std::optional<Eigen::MatrixXd>>> chain_marginals =
-      ChainMarginals(problem, ChainBlocks(states));
+      ChainMarginals(problem, ChainBlocks(states, with_depth_offset));
   if (chain_marginals &&
       std::all_of(chain_marginals->begin(), chain_marginals->end(),
                   [](const std::optional<Eigen::MatrixXd>& m) { return m.has_value(); })) {
@@ -209,6 +217,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     std::copy(r.pose, r.pose + kPoseSize, s->pose);
     std::copy(r.velocity, r.velocity + kVelocitySize, s->velocity);
     std::copy(r.bias, r.bias + kBiasSize, s->bias);
+    s->depth_offset[0] = r.depth_offset;
     states.push_back(std::move(s));
   }
 
@@ -225,11 +234,27 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   problem_options.enable_fast_removal = true;
   ceres::Problem problem(problem_options);
   const PoseManifold manifold;
+  const bool with_depth_offset = estimator_options.estimate_depth_offset &&
+                                 estimator_options.use_depth && calibration.depth.has_value();
   for (size_t k = 0; k < states.size(); ++k) {
     BatchState* s = states[k].get();
     problem.AddParameterBlock(s->pose, kPoseSize, const_cast<PoseManifold*>(&manifold));
     problem.AddParameterBlock(s->velocity, kVelocitySize);
     problem.AddParameterBlock(s->bias, kBiasSize);
+    if (with_depth_offset) {
+      // One offset along the whole log, drifting as a random walk; its prior at the start.
+      problem.AddParameterBlock(s->depth_offset, kDepthOffsetSize);
+      if (k == 0) {
+        problem.AddResidualBlock(
+            ScalarPriorFactor::Create(0.0, estimator_options.depth_offset_prior_sigma_m), nullptr,
+            s->depth_offset);
+      } else {
+        problem.AddResidualBlock(
+            ScalarRandomWalkFactor::Create(estimator_options.depth_offset_random_walk,
+                                           1e-9 * static_cast<double>(s->t_ns - states[k - 1]->t_ns)),
+            nullptr, states[k - 1]->depth_offset, s->depth_offset);
+      }
+    }
     bool joined = false;
     if (k > 0) {
       BatchState* p = states[k - 1].get();
@@ -262,7 +287,8 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     return after == states.begin() ? nullptr : std::prev(after)->get();
   };
   const auto blocks_of = [&](BatchState* s) {
-    return StateBlocks(s->pose, s->velocity, &buffer, BiasFromBlock(s->bias));
+    return StateBlocks(s->pose, s->velocity, &buffer, BiasFromBlock(s->bias),
+                       with_depth_offset ? s->depth_offset : nullptr);
   };
   std::vector<SensorResidual> depth_residuals;
   if (estimator_options.use_depth && calibration.depth) {
@@ -412,7 +438,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     return gate(&sbl_residuals, estimator_options.sbl_gate_chi2, calibration.sbl);
   };
   result.stats.sbl_gated = gate_sbl();
-  BatchSolve summary = SolveBatch(&problem, states, solver, estimator_options, options.progress);
+  BatchSolve summary = SolveBatch(&problem, states, with_depth_offset, solver, estimator_options, options.progress);
   result.initial_cost = summary.initial_cost;
   int gated = 0;
   for (auto& s : states) {
@@ -438,7 +464,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   result.stats.sbl_used = static_cast<int>(sbl_residuals.size());
   if (gated > 0 || depth_gated_after > 0 || dvl_gated_after > 0 || usbl_gated_after > 0 ||
       sbl_gated_after > 0 || heading_gated_after > 0) {
-    summary = SolveBatch(&problem, states, solver, estimator_options, options.progress);
+    summary = SolveBatch(&problem, states, with_depth_offset, solver, estimator_options, options.progress);
   }
   std::stable_sort(result.rejections.begin(), result.rejections.end(),
                    [](const Rejection& a, const Rejection& b) { return a.t_ns < b.t_ns; });
@@ -454,7 +480,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   result.converged = summary.converged;
 
   const std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> pose_covariances =
-      PoseMarginals(&problem, states);
+      PoseMarginals(&problem, states, with_depth_offset);
   int64_t last_vision = INT64_MIN;
   std::vector<int64_t> dvl_times;  // of the DVL samples kept, for the go/no-go's DVL age
   for (const SensorResidual& r : dvl_residuals) dvl_times.push_back(r.t_ns);
@@ -466,6 +492,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     out.T_D_B = PoseFromBlock(s->pose);
     out.v_D = Eigen::Map<const Eigen::Vector3d>(s->velocity);
     out.bias = BiasFromBlock(s->bias);
+    if (with_depth_offset) out.depth_offset_m = s->depth_offset[0];
     for (const VisionResidual& r : s->vision) (r.mono ? out.n_mono : out.n_stereo) += 1;
     out.n_gated = s->n_gated;
     if (!s->vision.empty()) last_vision = s->t_ns;

@@ -26,6 +26,11 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.vision.use_mono = est.GetBool("use_mono", e.vision.use_mono);
   e.use_depth = est.GetBool("use_depth", e.use_depth);
   e.depth_gate_chi2 = est.GetNonNegative("depth_gate_chi2", e.depth_gate_chi2);
+  e.estimate_depth_offset = est.GetBool("estimate_depth_offset", e.estimate_depth_offset);
+  e.depth_offset_prior_sigma_m =
+      est.GetPositive("depth_offset_prior_sigma_m", e.depth_offset_prior_sigma_m);
+  e.depth_offset_random_walk =
+      est.GetPositive("depth_offset_random_walk", e.depth_offset_random_walk);
   e.use_dvl = est.GetBool("use_dvl", e.use_dvl);
   e.dvl_gate_chi2 = est.GetNonNegative("dvl_gate_chi2", e.dvl_gate_chi2);
   e.use_usbl = est.GetBool("use_usbl", e.use_usbl);

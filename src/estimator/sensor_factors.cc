@@ -7,6 +7,7 @@
 #include <ceres/loss_function.h>
 
 #include "factors/depth_factor.h"
+#include "factors/depth_offset_factor.h"
 #include "factors/dvl_factor.h"
 #include "factors/heading_factor.h"
 #include "factors/time_shifted_factor.h"
@@ -34,11 +35,16 @@ std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
   const std::optional<ImuPoseShift> shift =
       ImuShiftFromState(state, t_state_ns, sample.t_ns - t_state_ns, dock.gravity_D);
   if (!shift) return std::nullopt;
-  return AddOnState<DepthFactor, kDepthResidualSize>(
-      problem,
-      std::make_unique<DepthFactor>(sample.depth_m, calibration.sigma_m * std::sqrt(variance_factor),
-                                    dock.origin_depth_m, dock.gravity_D, calibration.T_B_S.p),
-      *shift, HuberOrNone(huber_sigmas), state);
+  const DepthFactor depth(sample.depth_m, calibration.sigma_m * std::sqrt(variance_factor),
+                          dock.origin_depth_m, dock.gravity_D, calibration.T_B_S.p);
+  if (state.depth_offset != nullptr) {
+    if (state.velocity == nullptr) return std::nullopt;
+    return problem->AddResidualBlock(DepthOffsetFactor::Create(depth, *shift),
+                                     HuberOrNone(huber_sigmas), state.pose, state.velocity,
+                                     state.depth_offset);
+  }
+  return AddOnState<DepthFactor, kDepthResidualSize>(problem, std::make_unique<DepthFactor>(depth),
+                                                     *shift, HuberOrNone(huber_sigmas), state);
 }
 
 std::optional<ceres::ResidualBlockId> AddHeadingFactor(ceres::Problem* problem,

@@ -18,10 +18,12 @@
 #include "auvdock/estimator/marginalization.h"
 #include "auvdock/estimator/sensor_factors.h"
 #include "factors/bias_prior_factor.h"
+#include "factors/depth_offset_factor.h"
 #include "factors/imu_preintegration_factor.h"
 #include "factors/marginalization_factor.h"
 #include "factors/pose_manifold.h"
 #include "factors/pose_prior_factor.h"
+#include "factors/scalar_random_walk_factor.h"
 #include "factors/velocity_prior_factor.h"
 
 namespace auvdock {
@@ -53,8 +55,19 @@ struct SlidingWindowEstimator::State {
   double pose[kPoseSize] = {0, 0, 0, 0, 0, 0, 1};
   double velocity[kVelocitySize] = {0, 0, 0};
   double bias[kBiasSize] = {0, 0, 0, 0, 0, 0};
+  double depth_offset[kDepthOffsetSize] = {0};  // m; a block only with estimate_depth_offset
   std::vector<VisionResidual> vision;  // this frame's vision residuals still in the problem
   int n_gated = 0;
+
+  StateRecord Record() const {
+    StateRecord record;
+    record.t_ns = t_ns;
+    std::copy(pose, pose + kPoseSize, record.pose);
+    std::copy(velocity, velocity + kVelocitySize, record.velocity);
+    std::copy(bias, bias + kBiasSize, record.bias);
+    record.depth_offset = depth_offset[0];
+    return record;
+  }
 };
 
 SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
@@ -91,7 +104,9 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
       options_.mono_gate_chi2 < 0.0 || options_.stereo_gate_chi2 < 0.0 ||
       !(options_.init_position_sigma_m > 0.0) || !(options_.init_attitude_sigma_rad > 0.0) ||
       !(options_.init_velocity_sigma_mps > 0.0) || !(options_.init_gyro_bias_sigma > 0.0) ||
-      !(options_.init_accel_bias_sigma > 0.0)) {
+      !(options_.init_accel_bias_sigma > 0.0) ||
+      (options_.estimate_depth_offset && (!(options_.depth_offset_prior_sigma_m > 0.0) ||
+                                          !(options_.depth_offset_random_walk > 0.0)))) {
     throw std::invalid_argument("EstimatorOptions: a size, sigma or gate is out of range");
   }
   if (!calibration_.imu) {
@@ -101,6 +116,7 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
   rig_.stereo_right = calibration_.FindCameraByRole(CameraRole::kStereoRight);
   rig_.mono = calibration_.FindCameraByRole(CameraRole::kMono);
   rig_.dock = &dock_;
+  depth_offset_on_ = options_.estimate_depth_offset && options_.use_depth && calibration_.depth;
   Reset("");
   stats_.resets = 0;
   stats_.log.clear();
@@ -110,14 +126,7 @@ SlidingWindowEstimator::~SlidingWindowEstimator() = default;
 
 void SlidingWindowEstimator::Reset(const std::string& reason) {
   // The dropped states keep their last estimate in the history (the batch smoother's start).
-  for (const auto& state : window_) {
-    StateRecord record;
-    record.t_ns = state->t_ns;
-    std::copy(state->pose, state->pose + kPoseSize, record.pose);
-    std::copy(state->velocity, state->velocity + kVelocitySize, record.velocity);
-    std::copy(state->bias, state->bias + kBiasSize, record.bias);
-    history_.push_back(record);
-  }
+  for (const auto& state : window_) history_.push_back(state->Record());
   window_.clear();
   symmetry_unresolved_ = false;
   if (calibration_.dvl) {
@@ -131,6 +140,7 @@ void SlidingWindowEstimator::Reset(const std::string& reason) {
   dvl_rate_test_.Reset();
   dvl_admitted_ = false;
   newest_pose_velocity_covariance_.reset();
+  newest_depth_offset_variance_.reset();
   sbl_transducer_of_.clear();
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -260,6 +270,12 @@ void SlidingWindowEstimator::StartWindow(const InitialState& initial) {
       std::pow(options_.init_accel_bias_sigma, 2));
   problem_->AddResidualBlock(BiasPriorFactor::Create(Eigen::Matrix<double, 6, 1>::Zero(), bias_cov),
                              nullptr, state->bias);
+  if (depth_offset_on_) {
+    problem_->AddParameterBlock(state->depth_offset, kDepthOffsetSize);
+    problem_->AddResidualBlock(
+        ScalarPriorFactor::Create(0.0, options_.depth_offset_prior_sigma_m), nullptr,
+        state->depth_offset);
+  }
   window_.push_back(std::move(state));
 }
 
@@ -287,6 +303,14 @@ bool SlidingWindowEstimator::AddState(int64_t t_ns) {
   problem_->AddResidualBlock(ImuPreintegrationFactor::Create(*pim, dock_.gravity_D), nullptr,
                              previous.pose, previous.velocity, previous.bias, state->pose,
                              state->velocity, state->bias);
+  if (depth_offset_on_) {
+    state->depth_offset[0] = previous.depth_offset[0];
+    problem_->AddParameterBlock(state->depth_offset, kDepthOffsetSize);
+    problem_->AddResidualBlock(
+        ScalarRandomWalkFactor::Create(options_.depth_offset_random_walk,
+                                       Seconds(t_ns - previous.t_ns)),
+        nullptr, previous.depth_offset, state->depth_offset);
+  }
   window_.push_back(std::move(state));
   return true;
 }
@@ -323,7 +347,8 @@ bool SlidingWindowEstimator::Solve(bool stop_early) {
                         std::all_of(state->velocity, state->velocity + kVelocitySize,
                                     [](double x) { return std::isfinite(x); }) &&
                         std::all_of(state->bias, state->bias + kBiasSize,
-                                    [](double x) { return std::isfinite(x); });
+                                    [](double x) { return std::isfinite(x); }) &&
+                        std::isfinite(state->depth_offset[0]);
     if (!finite) return false;
   }
   return true;
@@ -480,7 +505,8 @@ void SlidingWindowEstimator::AddDvl(const DvlMeasurement& sample) {
 }
 
 StateBlocks SlidingWindowEstimator::BlocksOf(State& state) const {
-  return StateBlocks(state.pose, state.velocity, &imu_, BiasFromBlock(state.bias));
+  return StateBlocks(state.pose, state.velocity, &imu_, BiasFromBlock(state.bias),
+                     depth_offset_on_ ? state.depth_offset : nullptr);
 }
 
 SlidingWindowEstimator::State* SlidingWindowEstimator::StateFor(int64_t t_ns,
@@ -614,15 +640,10 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
 
 void SlidingWindowEstimator::MarginalizeOldest() {
   State& oldest = *window_.front();
-  StateRecord record;
-  record.t_ns = oldest.t_ns;
-  std::copy(oldest.pose, oldest.pose + kPoseSize, record.pose);
-  std::copy(oldest.velocity, oldest.velocity + kVelocitySize, record.velocity);
-  std::copy(oldest.bias, oldest.bias + kBiasSize, record.bias);
-  history_.push_back(record);
-
-  LinearizedPrior prior =
-      MarginalizeOut(problem_.get(), {oldest.pose, oldest.velocity, oldest.bias});
+  history_.push_back(oldest.Record());
+  std::vector<double*> blocks = {oldest.pose, oldest.velocity, oldest.bias};
+  if (depth_offset_on_) blocks.push_back(oldest.depth_offset);
+  LinearizedPrior prior = MarginalizeOut(problem_.get(), blocks);
   window_.pop_front();
   if (!prior.blocks.empty()) {
     auto* factor = new MarginalizationFactor(std::move(prior));
@@ -633,7 +654,10 @@ void SlidingWindowEstimator::MarginalizeOldest() {
 std::vector<std::vector<double*>> SlidingWindowEstimator::StateBlocksInOrder() const {
   std::vector<std::vector<double*>> states;
   states.reserve(window_.size());
-  for (const auto& s : window_) states.push_back({s->pose, s->velocity, s->bias});
+  for (const auto& s : window_) {
+    states.push_back({s->pose, s->velocity, s->bias});
+    if (depth_offset_on_) states.back().push_back(s->depth_offset);
+  }
   return states;
 }
 
@@ -654,6 +678,11 @@ std::optional<Eigen::MatrixXd> SlidingWindowEstimator::PoseCovariance(const Stat
   newest_pose_velocity_covariance_ =
       last->covariance->topLeftCorner(kPoseTangentSize + kVelocitySize,
                                       kPoseTangentSize + kVelocitySize);
+  // The offset block is the state's last (StateBlocksInOrder).
+  if (depth_offset_on_) {
+    const Eigen::Index k = last->covariance->rows() - 1;
+    newest_depth_offset_variance_ = (*last->covariance)(k, k);
+  }
   return last->covariance->topLeftCorner(kPoseTangentSize, kPoseTangentSize).eval();
 }
 
@@ -712,6 +741,7 @@ EstimatorOutput SlidingWindowEstimator::Output(const State& state) {
   out.T_D_B = PoseFromBlock(state.pose);
   out.v_D = Eigen::Map<const Eigen::Vector3d>(state.velocity);
   out.bias = BiasFromBlock(state.bias);
+  if (depth_offset_on_) out.depth_offset_m = state.depth_offset[0];
   for (const VisionResidual& r : state.vision) (r.mono ? out.n_mono : out.n_stereo) += 1;
   out.n_gated = state.n_gated;
   out.seconds_since_vision =
@@ -725,11 +755,18 @@ EstimatorOutput SlidingWindowEstimator::Output(const State& state) {
     if (covariance) {
       out.covariance = *covariance;
       out.covariance_ok = true;
+      if (depth_offset_on_ && newest_depth_offset_variance_ && &state == window_.back().get()) {
+        out.depth_offset_sigma_m = std::sqrt(*newest_depth_offset_variance_);
+      }
     } else {
       ++stats_.covariance_failures;
       stats_.log.push_back("covariance at " + std::to_string(state.t_ns) + " ns: " + reason +
                            ", not reported");
     }
+  }
+  if (depth_offset_on_ && &state == window_.back().get()) {
+    stats_.depth_offset_m = out.depth_offset_m;
+    stats_.depth_offset_sigma_m = out.depth_offset_sigma_m;
   }
   return out;
 }
@@ -891,14 +928,7 @@ std::optional<Pose3> SlidingWindowEstimator::PropagatedPose(int64_t t_ns) const 
 
 std::vector<StateRecord> SlidingWindowEstimator::History() const {
   std::vector<StateRecord> all = history_;
-  for (const auto& state : window_) {
-    StateRecord record;
-    record.t_ns = state->t_ns;
-    std::copy(state->pose, state->pose + kPoseSize, record.pose);
-    std::copy(state->velocity, state->velocity + kVelocitySize, record.velocity);
-    std::copy(state->bias, state->bias + kBiasSize, record.bias);
-    all.push_back(record);
-  }
+  for (const auto& state : window_) all.push_back(state->Record());
   return all;
 }
 

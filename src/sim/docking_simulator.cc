@@ -88,7 +88,7 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
 
   ImuSimulator imu(s.imu, g_D, s.initial_gyro_bias, s.initial_accel_bias, noisy,
                    MakeRandomStream(s.seed, RandomStreamId::kImu));
-  DepthSimulator depth(s.depth, s.dock, noisy, MakeRandomStream(s.seed, RandomStreamId::kDepth));
+  DepthSimulator depth(s.depth, s.depth_faults, s.dock, noisy, MakeRandomStream(s.seed, RandomStreamId::kDepth));
   DvlSimulator dvl(s.dvl, s.dvl_faults, noisy, MakeRandomStream(s.seed, RandomStreamId::kDvl));
   AcousticSimulator acoustic(s.acoustic, s.dock, s.acoustic_faults, noisy,
                              MakeRandomStream(s.seed, RandomStreamId::kAcoustic));
@@ -137,7 +137,9 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
     }
     for (; k_depth < n_depth && SampleTime(k_depth, s.depth.rate_hz) <= t_end_ns; ++k_depth) {
       const int64_t t = SampleTime(k_depth, s.depth.rate_hz);
-      writer.AddDepth(depth.Sample(t, trajectory_.At(Seconds(t))));
+      std::optional<FaultRecord> fault;
+      writer.AddDepth(depth.Sample(t, trajectory_.At(Seconds(t)), &fault));
+      record_fault(fault);
       ++summary.n_depth;
     }
     for (; k_dvl < n_dvl && SampleTime(k_dvl, s.dvl.rate_hz) <= t_end_ns; ++k_dvl) {

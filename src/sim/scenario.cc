@@ -182,6 +182,8 @@ Scenario LoadScenario(const std::string& path) {
   s.depth.rate_hz = depth.GetPositive("rate_hz", s.depth.rate_hz);
   s.depth.sigma_m = depth.GetPositive("sigma_m", s.depth.sigma_m);
   s.depth.T_B_S.p = depth.GetVector<3>("p_B", Eigen::Vector3d(-0.3, 0.0, -0.15));
+  s.depth_faults.bias_m = depth.GetDouble("bias_m", s.depth_faults.bias_m);
+  s.depth_faults.bias_rate_mps = depth.GetDouble("bias_rate_mps", s.depth_faults.bias_rate_mps);
 
   const ConfigNode dvl = root.ChildOrEmpty("dvl");
   s.dvl.rate_hz = dvl.GetPositive("rate_hz", s.dvl.rate_hz);

@@ -58,7 +58,8 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
     run.states.push_back({t, state.T_D_B, state.v_D, imu.gyro_bias(), imu.accel_bias()});
   }
 
-  DepthSimulator depth(scenario.depth, scenario.dock, true, MakeRandomStream(seed, 104));
+  DepthSimulator depth(scenario.depth, scenario.depth_faults, scenario.dock, true,
+                       MakeRandomStream(seed, 104));
   for (int64_t k = 0;; ++k) {
     const int64_t t = simulator.SampleTime(k, scenario.depth.rate_hz);
     if (simulator.Seconds(t) > scenario.duration_s) break;

@@ -41,7 +41,9 @@ inline constexpr double kNoRobustLoss = std::numeric_limits<double>::infinity();
 // The sample's residual on `state` (whose time is t_state_ns <= sample.t_ns); nothing when the
 // sample is not finite or the IMU does not reach its time.
 // variance_factor multiplies the configured variance (the adaptive estimate of the sensor's
-// effective noise, adaptive_noise_scale.h).
+// effective noise, adaptive_noise_scale.h). With the state's depth-offset block
+// (StateBlocks::depth_offset) the residual carries the offset (factors/depth_offset_factor.h, on
+// the pose, velocity and offset blocks; nothing without a velocity block).
 std::optional<ceres::ResidualBlockId> AddDepthFactor(ceres::Problem* problem,
                                                      const DepthMeasurement& sample,
                                                      const DepthCalibration& calibration,

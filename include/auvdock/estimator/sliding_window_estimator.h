@@ -8,6 +8,7 @@
 // + sum_k sum_lights w_mono(k)   rho(|r_mono|^2)     mono reprojection of identified dock lights
 // + sum_k sum_lights w_stereo(k) rho(|r_stereo|^2)   triangulated lights against the dock model
 // + sum_depth |r_depth|^2                            pressure depth against the dock's depth
+//   (+ sum_k |r_offset(b_k, b_k+1)|^2                 its offset's random walk, when estimated)
 // + sum_dvl |r_dvl|^2                                DVL velocity over ground, in its frame
 // + USBL fixes, SBL ranges, AHRS/compass headings      (estimator/sensor_factors.h)
 // where every r is whitened by its own noise model (pixel noise, triangulation covariance,
@@ -47,6 +48,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <deque>
 #include <map>
 #include <memory>
@@ -183,6 +185,16 @@ struct EstimatorOptions {
   // (chi-square, 1 dof, p = 0.999) after the solve is removed.
   bool use_depth = true;
   double depth_gate_chi2 = 10.83;
+  // The depth sensor's offset against the dock survey's depth (the tide since the survey, the
+  // air pressure, the water's density, a sensor bias) as a state: one number per window state,
+  // a random walk of depth_offset_random_walk (m/sqrt(s)) between neighbours, a prior of
+  // depth_offset_prior_sigma_m about 0 at the window's start (factors/depth_offset_factor.h).
+  // The lights and the acoustic fixes then observe the offset, and the depth gives the height
+  // relative to what they saw. Off: the depth is taken as the survey's (an offset of b metres
+  // biases the height by up to b wherever the lights do not fix it).
+  bool estimate_depth_offset = false;
+  double depth_offset_prior_sigma_m = 0.5;
+  double depth_offset_random_walk = 0.001;
   // DVL velocity over ground (the same, needs the calibration's DVL): 3 dof, p = 0.999. A sample
   // that is not finite is bottom lock lost: no measurement, counted apart.
   bool use_dvl = true;
@@ -266,6 +278,10 @@ struct EstimatorOutput {
   Pose3 T_D_B;
   Eigen::Vector3d v_D = Eigen::Vector3d::Zero();
   ImuBias bias;
+  // The depth sensor's estimated offset and its 1-sigma (m; NaN when not estimated, or the sigma
+  // when the covariance was not computed): EstimatorOptions::estimate_depth_offset.
+  double depth_offset_m = std::numeric_limits<double>::quiet_NaN();
+  double depth_offset_sigma_m = std::numeric_limits<double>::quiet_NaN();
   bool covariance_ok = false;                   // false: rank-deficient or not computed
   Matrix6d covariance = Matrix6d::Zero();       // tangent [dp_D, dtheta_D]
   int n_mono = 0, n_stereo = 0;                 // vision residuals used in this frame
@@ -319,6 +335,10 @@ struct EstimatorStats {
   double dvl_variance_factor = 1.0;  // adaptive_dvl_noise's factor in use at the end
   double depth_variance_factor = 1.0;  // adaptive_depth_noise's
   double sbl_variance_factor = 1.0;    // adaptive_sbl_noise's
+  // The depth sensor's offset at the newest estimate and its 1-sigma (m; NaN when not
+  // estimated: EstimatorOptions::estimate_depth_offset).
+  double depth_offset_m = std::numeric_limits<double>::quiet_NaN();
+  double depth_offset_sigma_m = std::numeric_limits<double>::quiet_NaN();
   std::vector<std::string> log;  // one line per skip/reset, for the caller's log
 };
 
@@ -328,6 +348,7 @@ struct StateRecord {
   double pose[7];
   double velocity[3];
   double bias[6];
+  double depth_offset = 0.0;  // m (0 when not estimated)
 };
 
 class SlidingWindowEstimator {
@@ -470,6 +491,9 @@ class SlidingWindowEstimator {
   // The newest state's marginal covariance of [pose tangent, velocity] after the last solve
   // (for the DVL's admission test); empty when not computed.
   std::optional<Eigen::Matrix<double, 9, 9>> newest_pose_velocity_covariance_;
+  std::optional<double> newest_depth_offset_variance_;  // with the above
+  // estimate_depth_offset with a depth sensor in use: every state has its offset block.
+  bool depth_offset_on_ = false;
   std::string init_refusal_;
   EstimatorStats stats_;
   // Per light id: the adaptive variance factors of its mono pixels and its stereo points.

@@ -27,15 +27,19 @@ namespace auvdock {
 
 // The pose block (factors/pose_manifold.h) and, for measurements after the state's time, its
 // velocity block, the IMU and the bias to preintegrate at. velocity and imu may be null for a
-// measurement at the state's own time.
+// measurement at the state's own time. depth_offset: the state's depth-sensor offset block
+// (factors/depth_offset_factor.h) when the estimator estimates one, else null.
 struct StateBlocks {
   explicit StateBlocks(double* pose_block, double* velocity_block = nullptr,
-                       const ImuBuffer* imu_buffer = nullptr, const ImuBias& state_bias = {})
-      : pose(pose_block), velocity(velocity_block), imu(imu_buffer), bias(state_bias) {}
+                       const ImuBuffer* imu_buffer = nullptr, const ImuBias& state_bias = {},
+                       double* depth_offset_block = nullptr)
+      : pose(pose_block), velocity(velocity_block), imu(imu_buffer), bias(state_bias),
+        depth_offset(depth_offset_block) {}
   double* pose;
   double* velocity;
   const ImuBuffer* imu;
   ImuBias bias;
+  double* depth_offset;
 };
 
 // The IMU's motion from the state's time t_state_ns to dt_ns later (dt_ns < 0: earlier, a late

@@ -13,6 +13,7 @@
 #include "auvdock/geometry/dock_model.h"
 #include "auvdock/io/calibration.h"
 #include "auvdock/sim/acoustic_simulator.h"
+#include "auvdock/sim/depth_simulator.h"
 #include "auvdock/sim/sbl_simulator.h"
 #include "auvdock/sim/docking_trajectory.h"
 #include "auvdock/sim/dvl_simulator.h"
@@ -63,6 +64,7 @@ struct Scenario {
   Eigen::Vector3d initial_gyro_bias = Eigen::Vector3d(0.002, -0.001, 0.0015);   // rad/s
   Eigen::Vector3d initial_accel_bias = Eigen::Vector3d(0.03, -0.02, 0.04);      // m/s^2
   DepthCalibration depth;
+  DepthFaultConfig depth_faults;  // scenario keys depth.bias_m, depth.bias_rate_mps
   DvlCalibration dvl;
   DvlFaultConfig dvl_faults;
   AcousticCalibration acoustic;
