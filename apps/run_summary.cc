@@ -65,6 +65,9 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
         {"used", given.used}, {"dropped", given.dropped}, {"refused", given.refused}};
   }
   summary["warnings"] = source.warnings();
+  if (const std::string depth = DepthDisagreementWarning(stats); !depth.empty()) {
+    summary["warnings"].push_back(depth);
+  }
   summary["adaptive_variance_factor"] = {{"mono", stats.mono_variance_factor},
                                          {"stereo", stats.stereo_variance_factor},
                                          {"dvl", stats.dvl_variance_factor},
@@ -100,6 +103,23 @@ void PrintSkippedRows(const char* command, const std::vector<std::string>& skipp
                  "auvdock: %s: ... and %zu more rows skipped (summary.json \"log\" lists them)\n",
                  command, skipped_rows.size() - max_lines);
   }
+}
+
+std::string DepthDisagreementWarning(const EstimatorStats& stats) {
+  const int samples = stats.depth_used + stats.depth_gated;
+  if (std::isfinite(stats.depth_offset_m) || samples < 20 || 4 * stats.depth_gated <= samples) {
+    return {};
+  }
+  return "the depth gate rejected " + std::to_string(stats.depth_gated) + " of " +
+         std::to_string(samples) +
+         " depth samples: the depth disagrees with the other sensors; if the sensor's zero is "
+         "not the dock survey's (tide, air pressure, water density), set estimate_depth_offset: "
+         "true";
+}
+
+void PrintDepthDisagreement(const char* command, const EstimatorStats& stats) {
+  const std::string warning = DepthDisagreementWarning(stats);
+  if (!warning.empty()) std::fprintf(stderr, "auvdock: %s: warning: %s\n", command, warning.c_str());
 }
 
 void PrintSymmetryUnresolved(const char* command, int count) {

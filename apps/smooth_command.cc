@@ -156,6 +156,7 @@ void Smooth(const SmoothOptions& options) {
     std::printf("  no vision: %d frames: %s\n", count, reason.c_str());
   }
   PrintSymmetryUnresolved("smooth", counters.symmetry_unresolved);
+  PrintDepthDisagreement("smooth", stats);
   PrintGivenIdentities(source);
 }
 

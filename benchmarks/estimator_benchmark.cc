@@ -26,9 +26,14 @@ const test::SyntheticRun& DefaultRun() {
   return run;
 }
 
+// with_depth: the run's depth samples fed too (at 10 Hz, each on the state at or before it);
+// without, the depth sensor is taken out of the calibration (vision and IMU alone, as the
+// issue's iSAM2 figures are).
 void RunWindow(benchmark::State& state, bool covariance, int window,
-               EstimatorOptions options = EstimatorOptions()) {
+               EstimatorOptions options = EstimatorOptions(), bool with_depth = false) {
   const test::SyntheticRun& run = DefaultRun();
+  Calibration calibration = run.calibration;
+  if (!with_depth) calibration.depth.reset();
   options.compute_covariance = covariance;
   options.window_size = window;
   std::vector<double> update_ms;
@@ -36,8 +41,8 @@ void RunWindow(benchmark::State& state, bool covariance, int window,
   double squared_error_sum = 0.0;  // position error against the truth, over the outputs
   int n_outputs = 0;
   for (auto _ : state) {
-    SlidingWindowEstimator estimator(run.calibration, run.dock, options);
-    size_t next_imu = 0;
+    SlidingWindowEstimator estimator(calibration, run.dock, options);
+    size_t next_imu = 0, next_depth = 0;
     update_ms.clear();
     squared_error_sum = 0.0;
     n_outputs = 0;
@@ -46,6 +51,10 @@ void RunWindow(benchmark::State& state, bool covariance, int window,
       const auto t0 = std::chrono::steady_clock::now();
       while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= frame.t_ns) {
         estimator.AddImu(run.imu[next_imu++]);
+      }
+      while (with_depth && next_depth < run.depth.size() &&
+             run.depth[next_depth].t_ns <= frame.t_ns) {
+        estimator.AddDepth(run.depth[next_depth++]);
       }
       const std::optional<EstimatorOutput> output = estimator.AddVisionFrame(frame);
       benchmark::DoNotOptimize(output);
@@ -86,7 +95,19 @@ void BM_WindowUpdateSmallDamping(benchmark::State& state) {
   options.solver_initial_damping = 1e-8;
   RunWindow(state, true, 10, options);
 }
+// With the depth sensor: its offset as a state (estimate_depth_offset, the default: one more
+// number per state) against the depth taken at the survey's zero, side by side.
+void BM_WindowUpdateDepth(benchmark::State& state) {
+  RunWindow(state, true, 10, EstimatorOptions(), true);
+}
+void BM_WindowUpdateDepthNoOffset(benchmark::State& state) {
+  EstimatorOptions options;
+  options.estimate_depth_offset = false;
+  RunWindow(state, true, 10, options, true);
+}
 BENCHMARK(BM_WindowUpdate)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_WindowUpdateDepth)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_WindowUpdateDepthNoOffset)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_WindowUpdateCeres)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_WindowUpdateSmallDamping)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_WindowUpdateNoCovariance)->Unit(benchmark::kMillisecond)->Iterations(3);

@@ -8,10 +8,10 @@
 //
 //   p_D_S = p_D_B + R_D_B p_B_S
 //   r = (origin_depth_m + g_hat . p_D_S - d) / sigma_m
-// which is the simulator's model (sim/depth_simulator.h). A slowly varying offset (tide, a
-// pressure bias, the water density) is not estimated here: an offset of b metres biases the
-// height by up to b where the lights do not fix it, and the estimator's gate catches only
-// jumps.
+// which is the simulator's model (sim/depth_simulator.h) without its offset. A slowly varying
+// offset (tide, a pressure bias, the water density) is not in this factor: an offset of b metres
+// biases the height by up to b where the lights do not fix it. factors/depth_offset_factor.h
+// carries it as a state (EstimatorOptions::estimate_depth_offset).
 // Jacobians: automatic differentiation (the residual is linear in p_D_B, smooth in q_D_B).
 #pragma once
 

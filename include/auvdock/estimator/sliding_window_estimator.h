@@ -174,11 +174,12 @@ struct EstimatorOptions {
   double smoother_vision_correlation_time_s = 5.0;
   // The same model for the sliding window, whose marginalisation prior carries the past frames'
   // information as the smoother's batch does: N_c s^2 added to every pixel coordinate's variance,
-  // N_c from the interval since the previous frame (0.07 px, 1 s at 10 Hz: N_c = 20, +0.1 px^2).
-  // Without it, centroids biased by a light's asymmetric lobe (randomised renders) give a mean
-  // NEES of 11-12; with it 8-9, and 4-5 on our plain renders (README, "Real water and any
-  // dock"). 0 = white errors only.
-  double window_vision_floor_px = 0.07;
+  // N_c from the interval since the previous frame (0.05 px, 1 s at 10 Hz: N_c = 20,
+  // +0.05 px^2). Without it, centroids biased by a light's asymmetric lobe (randomised renders)
+  // give a mean NEES of 11-12; with it 8.4, and 4.8 on our plain renders (0.07 px until
+  // 2026-12-06: 7.7 and 4.2, and the Monte-Carlo audit's runs mostly below their NEES band;
+  // README, "Replaying detections; the Monte-Carlo audit"). 0 = white errors only.
+  double window_vision_floor_px = 0.05;
   double window_vision_correlation_time_s = 1.0;
   // Pressure depth (estimator/sensor_factors.h; needs the calibration's depth sensor): each sample
   // against the dock's origin_depth_m, at its own time; a whitened residual beyond the gate
@@ -190,8 +191,13 @@ struct EstimatorOptions {
   // a random walk of depth_offset_random_walk (m/sqrt(s)) between neighbours, a prior of
   // depth_offset_prior_sigma_m about 0 at the window's start (factors/depth_offset_factor.h).
   // The lights and the acoustic fixes then observe the offset, and the depth gives the height
-  // relative to what they saw. Off: the depth is taken as the survey's (an offset of b metres
-  // biases the height by up to b wherever the lights do not fix it).
+  // relative to what they saw. Off: the depth is taken as the survey's zero. Off by default:
+  // with a zero that is the survey's, the free offset costs the height its anchor (a looser
+  // height until the lights have measured it; the lights' own biases then reach the height, and
+  // a run that starts from a wrong pose can run away along it). On for a sensor whose zero is
+  // not the survey's: an offset of 0.3 m taken at its word made the default scenario's NEES 557
+  // with unsafe GO. Measured in the README ("Depth and DVL"). `run` and `smooth` warn when the
+  // depth gate rejects most samples (EstimatorStats::depth_gated), the sign of such an offset.
   bool estimate_depth_offset = false;
   double depth_offset_prior_sigma_m = 0.5;
   double depth_offset_random_walk = 0.001;
