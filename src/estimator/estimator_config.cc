@@ -103,6 +103,8 @@ RunConfig LoadRunConfig(const std::string& path) {
   g.max_dvl_age_s = go.GetPositive("max_dvl_age_s", g.max_dvl_age_s);
   g.max_aided_vision_age_s = go.GetPositive("max_aided_vision_age_s", g.max_aided_vision_age_s);
   g.max_gating_rate = go.GetNonNegative("max_gating_rate", g.max_gating_rate);
+  g.max_depth_gating_rate = go.GetNonNegative("max_depth_gating_rate", g.max_depth_gating_rate);
+  g.min_depth_samples = go.GetInt("min_depth_samples", g.min_depth_samples);
   g.gating_window_frames = go.GetInt("gating_window_frames", g.gating_window_frames);
   if (g.gating_window_frames < 1) go.Fail("gating_window_frames", "must be at least 1");
   root.CheckNoUnknownKeys();

@@ -21,19 +21,25 @@ GoNoGo::GoNoGo(const GoNoGoOptions& options) : options_(options) {
   if (!(options_.allowed_lateral_error_m > 0.0) || !(options_.max_yaw_3sigma_rad > 0.0) ||
       !(options_.max_vision_age_s > 0.0) || !(options_.max_dvl_age_s > 0.0) ||
       !(options_.max_aided_vision_age_s > 0.0) || !(options_.max_gating_rate >= 0.0) ||
-      options_.gating_window_frames < 1) {
+      options_.gating_window_frames < 1 || !(options_.max_depth_gating_rate >= 0.0) ||
+      options_.min_depth_samples < 1) {
     throw std::invalid_argument("GoNoGoOptions: thresholds must be positive");
   }
 }
 
 GoNoGoDecision GoNoGo::NoEstimate(const std::string& reason) {
   recent_.clear();
+  recent_depth_.clear();
   return {false, "no estimate: " + reason};
 }
 
 GoNoGoDecision GoNoGo::Decide(const EstimatorOutput& output) {
   recent_.emplace_back(output.n_mono + output.n_stereo, output.n_gated);
   while (static_cast<int>(recent_.size()) > options_.gating_window_frames) recent_.pop_front();
+  recent_depth_.emplace_back(output.n_depth, output.n_depth_gated);
+  while (static_cast<int>(recent_depth_.size()) > options_.gating_window_frames) {
+    recent_depth_.pop_front();
+  }
 
   if (!output.covariance_ok || !output.covariance.allFinite()) {
     return {false, "covariance unavailable (rank-deficient or not computed)"};
@@ -62,6 +68,19 @@ GoNoGoDecision GoNoGo::Decide(const EstimatorOutput& output) {
   if (rate > options_.max_gating_rate) {
     return {false, Format("gating rate %.2f over the recent frames (limit %.2f)", rate,
                           options_.max_gating_rate)};
+  }
+  int depth_samples = 0, depth_gated = 0;
+  for (const auto& [n, g] : recent_depth_) {
+    depth_samples += n;
+    depth_gated += g;
+  }
+  if (depth_samples >= options_.min_depth_samples &&
+      depth_gated > options_.max_depth_gating_rate * depth_samples) {
+    char reason[128];
+    std::snprintf(reason, sizeof(reason),
+                  "the depth disagrees: %d of %d samples gated over the recent frames (limit %.2f)",
+                  depth_gated, depth_samples, options_.max_depth_gating_rate);
+    return {false, reason};
   }
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> horizontal(
       output.covariance.topLeftCorner<2, 2>());

@@ -869,6 +869,8 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   while (static_cast<int>(window_.size()) > options_.window_size) MarginalizeOldest();
 
   EstimatorOutput out = Output(*state);
+  out.n_depth = static_cast<int>(depth.size()) + depth_gated;
+  out.n_depth_gated = depth_gated;
   if (out.covariance_ok && options_.adaptive_vision_noise.enabled) {
     UpdateNoiseScales(*state, out.covariance);
   }

@@ -109,6 +109,29 @@ TEST(GoNoGoTest, ManyGatedResidualsInRecentFramesAreNoGo) {
   EXPECT_TRUE(decide.Decide(PreciseOutput()).go);
 }
 
+// A depth sensor the gate keeps rejecting disagrees with the estimate: NO-GO once enough samples
+// came, GO again once the rejections leave the window; a single rejected sample among few is not
+// enough to judge.
+TEST(GoNoGoTest, ADepthThatTheGateKeepsRejectingIsNoGo) {
+  GoNoGoOptions options;
+  options.gating_window_frames = 4;
+  options.min_depth_samples = 3;
+  GoNoGo decide(options);
+  EstimatorOutput out = PreciseOutput();
+  out.n_depth = 1;
+  out.n_depth_gated = 1;
+  EXPECT_TRUE(decide.Decide(out).go);  // 1 sample: too few to judge
+  out.n_depth = 2;
+  out.n_depth_gated = 1;
+  const GoNoGoDecision d = decide.Decide(out);  // 2 of 3 gated
+  EXPECT_FALSE(d.go);
+  EXPECT_THAT(d.reason, HasSubstr("the depth disagrees: 2 of 3 samples gated"));
+  EstimatorOutput clean = PreciseOutput();
+  clean.n_depth = 1;
+  for (int i = 0; i < 3; ++i) decide.Decide(clean);
+  EXPECT_TRUE(decide.Decide(clean).go);  // the gated ones have left the window
+}
+
 TEST(GoNoGoTest, RejectsNonPositiveThresholds) {
   GoNoGoOptions options;
   options.allowed_lateral_error_m = 0.0;

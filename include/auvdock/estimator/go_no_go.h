@@ -19,6 +19,11 @@
 //   3. gating health: over the last gating_window_frames frames, the share of vision residuals
 //      rejected by the chi-square gate is at most max_gating_rate (many rejections mean the
 //      model and the data disagree: misidentified lights, reflections, a bad calibration);
+//   3b. depth health: over the same frames, the share of depth samples rejected by the depth gate
+//      is at most max_depth_gating_rate (when at least min_depth_samples came): a depth sensor
+//      that the gate keeps rejecting disagrees with the estimate, whichever of the two is wrong
+//      (a sensor whose zero is not the dock survey's, taken at its word, made 3 unsafe GO on the
+//      default scenario with 0.3 m of offset; EstimatorOptions::estimate_depth_offset);
 //   4. lateral precision: 3 sigma of the horizontal position, along the major axis of its 2 x 2
 //      covariance in the dock frame (x, y), is at most allowed_lateral_error_m (the landing
 //      tolerance of the platform; the major axis covers the along-track and cross-track
@@ -44,6 +49,8 @@ struct GoNoGoOptions {
   double max_aided_vision_age_s = 10.0;  // ... lets vision be this old
   double max_gating_rate = 0.3;
   int gating_window_frames = 20;
+  double max_depth_gating_rate = 0.3;
+  int min_depth_samples = 5;
 };
 
 struct GoNoGoDecision {
@@ -64,6 +71,7 @@ class GoNoGo {
  private:
   GoNoGoOptions options_;
   std::deque<std::pair<int, int>> recent_;  // (used, gated) per frame
+  std::deque<std::pair<int, int>> recent_depth_;  // (samples, gated) per frame
 };
 
 }  // namespace auvdock

@@ -292,6 +292,8 @@ struct EstimatorOutput {
   Matrix6d covariance = Matrix6d::Zero();       // tangent [dp_D, dtheta_D]
   int n_mono = 0, n_stereo = 0;                 // vision residuals used in this frame
   int n_gated = 0;                              // vision residuals rejected in this frame
+  // Depth samples attached with this frame and how many of them the depth gate rejected.
+  int n_depth = 0, n_depth_gated = 0;
   double seconds_since_vision = -1.0;           // age of the newest used vision (-1: never)
   double seconds_since_dvl = -1.0;              // of the newest used DVL sample (-1: never)
   // The window started from a pose chosen among a symmetric dock's rival poses by nothing
