@@ -132,10 +132,11 @@ void Smooth(const SmoothOptions& options) {
   stats.sbl_used = result.stats.sbl_used;
   stats.sbl_gated = result.stats.sbl_gated;
   stats.sbl_skipped = result.stats.sbl_skipped;
-  // The batch's own offset at the log's end (its sigma is not computed: null).
+  // The batch's own offset at the log's end, with its marginal sigma.
   stats.depth_offset_m = result.outputs.empty() ? std::numeric_limits<double>::quiet_NaN()
                                                 : result.outputs.back().depth_offset_m;
-  stats.depth_offset_sigma_m = std::numeric_limits<double>::quiet_NaN();
+  stats.depth_offset_sigma_m = result.outputs.empty() ? std::numeric_limits<double>::quiet_NaN()
+                                                      : result.outputs.back().depth_offset_sigma_m;
   nlohmann::json summary = MakeRunSummary(source, stats, skipped_rows, counters);
   summary["batch"] = {{"segments", result.segments},
                       {"iterations", result.iterations},

@@ -150,19 +150,23 @@ double MedianStateInterval(const std::vector<std::unique_ptr<BatchState>>& state
 // ceres::Covariance when the problem is not a chain, or when the sweeps find a segment
 // rank-deficient: they work on H = J^T J, whose condition number is the square of J's, and a
 // long stretch on the IMU alone can leave a legitimately small information at rounding level
-// there; the QR of J decides.
+// there; the QR of J decides. With the depth offset, *offset_variances gets each state's offset
+// variance (the offset block is a state's last coordinate; NaN where not had).
 std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> PoseMarginals(
     ceres::Problem* problem, const std::vector<std::unique_ptr<BatchState>>& states,
-    bool with_depth_offset) {
+    bool with_depth_offset, std::vector<double>* offset_variances) {
   std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> marginals(states.size());
+  offset_variances->assign(states.size(), std::numeric_limits<double>::quiet_NaN());
   const std::optional<std::vector<std::optional<Eigen::MatrixXd>>> chain_marginals =
       ChainMarginals(problem, ChainBlocks(states, with_depth_offset));
   if (chain_marginals &&
       std::all_of(chain_marginals->begin(), chain_marginals->end(),
                   [](const std::optional<Eigen::MatrixXd>& m) { return m.has_value(); })) {
     for (size_t k = 0; k < states.size(); ++k) {
-      const Eigen::Matrix<double, 6, 6> pose = (*chain_marginals)[k]->topLeftCorner<6, 6>();
+      const Eigen::MatrixXd& full = *(*chain_marginals)[k];
+      const Eigen::Matrix<double, 6, 6> pose = full.topLeftCorner<6, 6>();
       if (pose.allFinite()) marginals[k] = pose;
+      if (with_depth_offset) (*offset_variances)[k] = full(full.rows() - 1, full.cols() - 1);
     }
     return marginals;
   }
@@ -479,8 +483,9 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   result.iterations = summary.iterations;
   result.converged = summary.converged;
 
+  std::vector<double> offset_variances;
   const std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> pose_covariances =
-      PoseMarginals(&problem, states, with_depth_offset);
+      PoseMarginals(&problem, states, with_depth_offset, &offset_variances);
   int64_t last_vision = INT64_MIN;
   std::vector<int64_t> dvl_times;  // of the DVL samples kept, for the go/no-go's DVL age
   for (const SensorResidual& r : dvl_residuals) dvl_times.push_back(r.t_ns);
@@ -492,7 +497,10 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     out.T_D_B = PoseFromBlock(s->pose);
     out.v_D = Eigen::Map<const Eigen::Vector3d>(s->velocity);
     out.bias = BiasFromBlock(s->bias);
-    if (with_depth_offset) out.depth_offset_m = s->depth_offset[0];
+    if (with_depth_offset) {
+      out.depth_offset_m = s->depth_offset[0];
+      if (offset_variances[k] >= 0.0) out.depth_offset_sigma_m = std::sqrt(offset_variances[k]);
+    }
     for (const VisionResidual& r : s->vision) (r.mono ? out.n_mono : out.n_stereo) += 1;
     out.n_gated = s->n_gated;
     if (!s->vision.empty()) last_vision = s->t_ns;

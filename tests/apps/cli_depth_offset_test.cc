@@ -72,9 +72,10 @@ TEST(DepthOffsetCli, AnOffsetIsWarnedOfOrEstimated) {
     const nlohmann::json s2 = Summary(estimated);
     ASSERT_TRUE(s2.contains("depth_offset")) << command;
     EXPECT_NEAR(s2["depth_offset"]["m"].get<double>(), 0.3, 0.03) << command;
-    if (command == "run") {
-      EXPECT_LT(s2["depth_offset"]["sigma_m"].get<double>(), 0.03);
-    }
+    EXPECT_LT(s2["depth_offset"]["sigma_m"].get<double>(), 0.03) << command;
+    EXPECT_LT(std::abs(s2["depth_offset"]["m"].get<double>() - 0.3),
+              3.0 * s2["depth_offset"]["sigma_m"].get<double>() + 0.005)
+        << command;
     EXPECT_LE(s2["depth_samples"]["gated"].get<int>(), 2) << command;
 
     // A sensor at the survey's zero: nothing to warn of.

@@ -443,9 +443,11 @@ TEST(SlidingWindowEstimatorTest, ADepthOffsetIsLearntFromTheLightsAndHoldsTheHei
       ASSERT_FALSE(batch.outputs.empty());
       const EstimatorOutput& end = batch.outputs.back();
       const double truth = 0.3 + 2e-4 * (end.t_ns - run.depth.front().t_ns) * 1e-9;
-      std::printf("batch: offset at the end %.4f m (truth %.4f), depth gated %d\n",
-                  end.depth_offset_m, truth, batch.stats.depth_gated);
+      std::printf("batch: offset at the end %.4f m (sigma %.4f, truth %.4f), depth gated %d\n",
+                  end.depth_offset_m, end.depth_offset_sigma_m, truth, batch.stats.depth_gated);
       EXPECT_LT(std::abs(end.depth_offset_m - truth), 0.015);
+      ASSERT_TRUE(std::isfinite(end.depth_offset_sigma_m));
+      EXPECT_LT(std::abs(end.depth_offset_m - truth), 3.0 * end.depth_offset_sigma_m);
       EXPECT_EQ(batch.stats.depth_gated, 0);
     }
     std::printf("offset %s: depth used %d, gated %d\n", estimated ? "estimated" : "ignored",
