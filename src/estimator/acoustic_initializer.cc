@@ -75,7 +75,8 @@ AcousticInitializer::AcousticInitializer(const Calibration& calibration, const D
                                          const AcousticInitOptions& options)
     : heading_sensor_(calibration.heading), options_(options) {
   const Eigen::Vector3d& gravity_D = dock.gravity_D;
-  if (options.min_fixes < 3 || options.min_fixes_with_heading < 2 || !(options.max_span_s > 0.0) || !(options.max_dvl_gap_s > 0.0) ||
+  if (options.min_fixes < 3 || options.min_fixes_with_heading < 1 ||
+      !(options.unconfirmed_fix_sigma_m > 0.0) || !(options.max_span_s > 0.0) || !(options.max_dvl_gap_s > 0.0) ||
       !(options.max_heading_sigma_rad > 0.0) || !(options.gate_chi2 > 0.0) ||
       !(options.tilt_sigma_rad > 0.0) || !(options.gyro_bias_sigma >= 0.0) ||
       !(options.velocity_sigma_mps > 0.0)) {
@@ -289,6 +290,12 @@ std::optional<InitialState> AcousticInitializer::Solve(const ImuBuffer& imu, int
   cov.bottomRightCorner<3, 3>() =
       options_.tilt_sigma_rad * options_.tilt_sigma_rad * P + var_psi * g * g.transpose();
   state.pose_covariance = variance_factor * cov;
+  if (kept == 1) {
+    state.unconfirmed = true;
+    state.pose_covariance.topLeftCorner<3, 3>() +=
+        options_.unconfirmed_fix_sigma_m * options_.unconfirmed_fix_sigma_m *
+        Eigen::Matrix3d::Identity();
+  }
   state.velocity_covariance =
       options_.velocity_sigma_mps * options_.velocity_sigma_mps * Eigen::Matrix3d::Identity() +
       var_psi * state.v_D.squaredNorm() * P;

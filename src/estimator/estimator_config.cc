@@ -57,6 +57,13 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.acoustic_init.enabled = est.GetBool("acoustic_init", e.acoustic_init.enabled);
   e.acoustic_init.min_fixes = est.GetInt("acoustic_init_min_fixes", e.acoustic_init.min_fixes);
   if (e.acoustic_init.min_fixes < 3) est.Fail("acoustic_init_min_fixes", "must be at least 3");
+  e.acoustic_init.min_fixes_with_heading = est.GetInt("acoustic_init_min_fixes_with_heading",
+                                                      e.acoustic_init.min_fixes_with_heading);
+  if (e.acoustic_init.min_fixes_with_heading < 1) {
+    est.Fail("acoustic_init_min_fixes_with_heading", "must be at least 1");
+  }
+  e.acoustic_init.unconfirmed_fix_sigma_m = est.GetPositive(
+      "acoustic_init_unconfirmed_fix_sigma_m", e.acoustic_init.unconfirmed_fix_sigma_m);
   e.acoustic_init.max_span_s = est.GetPositive("acoustic_init_max_span_s", e.acoustic_init.max_span_s);
   e.acoustic_init.max_heading_sigma_rad = est.GetPositive(
       "acoustic_init_max_heading_sigma_rad", e.acoustic_init.max_heading_sigma_rad);

@@ -235,8 +235,9 @@ bool SlidingWindowEstimator::InitializeAcoustically(int64_t t_ns) {
   ++stats_.acoustic_starts;
   char text[200];
   std::snprintf(text, sizeof(text),
-                "acoustic start at %lld ns: %d fixes (%d left out), heading %s to %.1f deg",
+                "acoustic start at %lld ns: %d fixes (%d left out%s), heading %s to %.1f deg",
                 static_cast<long long>(t_ns), initial->fixes_used, initial->fixes_rejected,
+                initial->unconfirmed ? "; unconfirmed: sigma widened to an outlier's size" : "",
                 initial->heading_measured ? "measured" : "from the path",
                 initial->heading_sigma_rad * 180.0 / M_PI);
   stats_.log.push_back(text);

@@ -162,9 +162,10 @@ TEST(AcousticInitializerTest, RejectsOptionsOutOfRange) {
   EXPECT_THROW(AcousticInitializer(run.calibration, weightless), std::invalid_argument);
 }
 
-// With an AHRS (2 degrees) the heading is measured: two fixes that agree start it, within about
-// two seconds, with the heading within 3 of the sensor's sigma.
-TEST(AcousticInitializerTest, WithAHeadingSensorTwoFixesSuffice) {
+// With an AHRS (2 degrees) the heading is measured: the first fix starts it, within the first
+// second, with the heading within 3 of the sensor's sigma, and a position covariance that covers
+// an outlier (the fix is unconfirmed); with two fixes required, the second fix starts it.
+TEST(AcousticInitializerTest, WithAHeadingSensorOneFixStartsItUnconfirmed) {
   Scenario scenario = test::LongApproachScenario(20.0);
   scenario.dvl_faults.gross_error_probability = 0.0;
   scenario.heading = HeadingCalibration{};
@@ -173,28 +174,42 @@ TEST(AcousticInitializerTest, WithAHeadingSensorTwoFixesSuffice) {
   const test::SyntheticRun run = test::MakeSyntheticRun(scenario, 3);
   ASSERT_FALSE(run.heading.empty());
   const std::vector<AcousticFix> fixes = test::MakeAcousticFixes(run, 14);
-  ImuBuffer imu(*run.calibration.imu, 0.1);
-  AcousticInitializer init(run.calibration, run.dock);
-  Fed fed;
-  size_t next_heading = 0;
-  std::string why;
-  for (size_t k = 0; k < run.frames.size(); ++k) {
-    const int64_t t = run.frames[k].t_ns;
-    FeedUpTo(run, fixes, t, &imu, &init, &fed);
-    while (next_heading < run.heading.size() && run.heading[next_heading].t_ns <= t) {
-      init.AddHeading(run.heading[next_heading++]);
+  for (const int min_fixes : {1, 2}) {
+    SCOPED_TRACE(min_fixes);
+    ImuBuffer imu(*run.calibration.imu, 0.1);
+    AcousticInitOptions options;
+    options.min_fixes_with_heading = min_fixes;
+    AcousticInitializer init(run.calibration, run.dock, options);
+    Fed fed;
+    size_t next_heading = 0;
+    std::string why;
+    std::optional<InitialState> state;
+    size_t k = 0;
+    for (; k < run.frames.size() && !state; ++k) {
+      const int64_t t = run.frames[k].t_ns;
+      FeedUpTo(run, fixes, t, &imu, &init, &fed);
+      while (next_heading < run.heading.size() && run.heading[next_heading].t_ns <= t) {
+        init.AddHeading(run.heading[next_heading++]);
+      }
+      state = init.Solve(imu, t, &why);
     }
-    const std::optional<InitialState> state = init.Solve(imu, t, &why);
-    if (!state) continue;
+    ASSERT_TRUE(state) << "no start: " << why;
+    --k;
     EXPECT_TRUE(state->heading_measured);
-    EXPECT_EQ(state->fixes_used, 2);
-    EXPECT_LT(t - run.frames.front().t_ns, 2'000'000'000) << "started at frame " << k;
+    EXPECT_EQ(state->fixes_used, min_fixes);
+    EXPECT_EQ(state->unconfirmed, min_fixes == 1);
+    const int64_t since_start = run.frames[k].t_ns - run.frames.front().t_ns;
+    EXPECT_LT(since_start, (min_fixes == 1 ? 1'000'000'000 : 2'000'000'000));
     EXPECT_LE(std::abs(HeadingError(state->T_D_B, run.truth[k].T_D_B)),
               3.0 * state->heading_sigma_rad);
     EXPECT_LT((state->T_D_B.p - run.truth[k].T_D_B.p).head<2>().norm(), 0.5);
-    return;
+    const double sigma_x = std::sqrt(state->pose_covariance(0, 0));
+    if (min_fixes == 1) {
+      EXPECT_GT(sigma_x, options.unconfirmed_fix_sigma_m);  // covers an outlier
+    } else {
+      EXPECT_LT(sigma_x, 0.5);
+    }
   }
-  FAIL() << "no start: " << why;
 }
 
 }  // namespace

@@ -1079,50 +1079,80 @@ TEST(SlidingWindowEstimatorTest, StartsWithoutLightsFromTheAcousticFixesAndTheDv
   }
 }
 
-// The same with an AHRS (2 degrees): two fixes and the measured heading start the window within
-// about two seconds (the second fix's measurement and latency), within the target from there.
-TEST(SlidingWindowEstimatorTest, AHeadingSensorStartsTheWindowFromTwoFixes) {
+// The same with an AHRS (2 degrees): the measured heading and two fixes start the window within
+// about two seconds (the second fix's measurement and latency), within the target from there;
+// with acoustic_init_min_fixes_with_heading 1, the first fix within the first second. A first fix
+// that is an outlier (2.2 m off) starts it too, unconfirmed: its covariance covers the error (the
+// horizontal error within 3 sigma), the next fixes pass the gate and pull the window back within
+// the target in a few seconds.
+TEST(SlidingWindowEstimatorTest, AHeadingSensorStartsTheWindowFromTheFirstFixes) {
   Scenario scenario = test::LongApproachScenario(25.0);
   scenario.heading = HeadingCalibration{};
   scenario.heading->sigma_rad = 2.0 * M_PI / 180.0;
   const test::SyntheticRun run = test::MakeSyntheticRun(scenario, 4);
-  const std::vector<AcousticFix> fixes = test::MakeAcousticFixes(run, 5, 1.0);
-  SlidingWindowEstimator estimator(run.calibration, run.dock);
-  size_t next_imu = 0, next_dvl = 0, next_heading = 0, next_fix = 0;
-  int first = -1;
-  double max_xy = 0.0;
-  for (size_t k = 0; k < run.frames.size(); ++k) {
-    const int64_t t = run.frames[k].t_ns;
-    while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= t) {
-      estimator.AddImu(run.imu[next_imu++]);
+  struct Case {
+    int min_fixes;
+    bool first_is_outlier;
+    double max_start_s;
+  };
+  for (const Case c : {Case{2, false, 2.5}, Case{1, false, 1.0}, Case{1, true, 1.0}}) {
+    const bool first_is_outlier = c.first_is_outlier;
+    SCOPED_TRACE(c.min_fixes);
+    SCOPED_TRACE(first_is_outlier);
+    std::vector<AcousticFix> fixes = test::MakeAcousticFixes(run, 5, 1.0);
+    if (first_is_outlier) fixes.front().p_D += Eigen::Vector3d(2.0, -1.0, 0.0);
+    EstimatorOptions options;
+    options.acoustic_init.min_fixes_with_heading = c.min_fixes;
+    SlidingWindowEstimator estimator(run.calibration, run.dock, options);
+    size_t next_imu = 0, next_dvl = 0, next_heading = 0, next_fix = 0;
+    int first = -1;
+    double max_xy = 0.0, max_xy_after_5s = 0.0, max_chi2 = 0.0;
+    for (size_t k = 0; k < run.frames.size(); ++k) {
+      const int64_t t = run.frames[k].t_ns;
+      while (next_imu < run.imu.size() && run.imu[next_imu].t_ns <= t) {
+        estimator.AddImu(run.imu[next_imu++]);
+      }
+      while (next_dvl < run.dvl.size() && run.dvl[next_dvl].t_ns <= t) {
+        estimator.AddDvl(run.dvl[next_dvl++]);
+      }
+      while (next_heading < run.heading.size() && run.heading[next_heading].t_ns <= t) {
+        estimator.AddHeading(run.heading[next_heading++]);
+      }
+      while (next_fix < fixes.size() && fixes[next_fix].arrival_t_ns() <= t) {
+        estimator.AddUsbl(fixes[next_fix++]);
+      }
+      const auto out = estimator.AddVisionFrame(run.frames[k]);
+      if (!out) continue;
+      if (first < 0) first = static_cast<int>(k);
+      const Eigen::Vector2d e = (out->T_D_B.p - run.truth[k].T_D_B.p).head<2>();
+      max_xy = std::max(max_xy, e.norm());
+      if (t - run.frames[first].t_ns > 5'000'000'000) max_xy_after_5s = std::max(max_xy_after_5s, e.norm());
+      ASSERT_TRUE(out->covariance_ok) << k;
+      max_chi2 = std::max(max_chi2, e.dot(out->covariance.topLeftCorner<2, 2>().ldlt().solve(e)));
     }
-    while (next_dvl < run.dvl.size() && run.dvl[next_dvl].t_ns <= t) {
-      estimator.AddDvl(run.dvl[next_dvl++]);
+    ASSERT_GE(first, 0);
+    const double start_s = (run.frames[first].t_ns - run.frames.front().t_ns) * 1e-9;
+    std::printf("acoustic start with a heading sensor at %.1f s%s; largest horizontal error %.3f m "
+                "(%.3f m after 5 s), largest chi-square %.1f\n",
+                start_s, first_is_outlier ? " on an outlier" : "", max_xy, max_xy_after_5s,
+                max_chi2);
+    EXPECT_LT(start_s, c.max_start_s);
+    EXPECT_LT(max_xy_after_5s, 0.3);
+    EXPECT_LT(max_chi2, 13.82);  // 2 dof, p = 0.999
+    if (!first_is_outlier) {
+      EXPECT_LT(max_xy, 0.3);
     }
-    while (next_heading < run.heading.size() && run.heading[next_heading].t_ns <= t) {
-      estimator.AddHeading(run.heading[next_heading++]);
-    }
-    while (next_fix < fixes.size() && fixes[next_fix].arrival_t_ns() <= t) {
-      estimator.AddUsbl(fixes[next_fix++]);
-    }
-    const auto out = estimator.AddVisionFrame(run.frames[k]);
-    if (!out) continue;
-    if (first < 0) first = static_cast<int>(k);
-    max_xy = std::max(max_xy, (out->T_D_B.p - run.truth[k].T_D_B.p).head<2>().norm());
+    const EstimatorStats& stats = estimator.stats();
+    EXPECT_EQ(stats.acoustic_starts, 1);
+    EXPECT_EQ(stats.resets, 0);
+    EXPECT_GT(stats.heading_used, 150);
+    EXPECT_LT(stats.heading_gated, 5);
+    EXPECT_EQ(std::any_of(stats.log.begin(), stats.log.end(),
+                          [](const std::string& line) {
+                            return line.find("unconfirmed") != std::string::npos;
+                          }),
+              c.min_fixes == 1);
   }
-  ASSERT_GE(first, 0);
-  const double start_s = (run.frames[first].t_ns - run.frames.front().t_ns) * 1e-9;
-  std::printf("acoustic start with a heading sensor at %.1f s; largest horizontal error %.3f m\n",
-              start_s, max_xy);
-  EXPECT_LT(start_s, 2.5);
-  EXPECT_LT(max_xy, 0.3);  // measured 0.216 m (the first estimate rests on two 0.2 m fixes)
-  const EstimatorStats& stats = estimator.stats();
-  EXPECT_EQ(stats.acoustic_starts, 1);
-  EXPECT_GT(stats.heading_used, 150);
-  EXPECT_LT(stats.heading_gated, 5);
-  EXPECT_TRUE(std::any_of(stats.log.begin(), stats.log.end(), [](const std::string& line) {
-    return line.find("heading measured") != std::string::npos;
-  }));
 }
 
 }  // namespace

@@ -40,8 +40,14 @@
 // With a heading sensor (the calibration's `heading`, an AHRS or compass; geometry/heading.h)
 // the heading is measured instead: psi = wrap(h - heading(R_W_B(t_h) R_B_S e_x)) from its
 // newest sample h at t_h on the path, sigma_psi^2 = sigma_h^2 + (gyro_bias_sigma (t - t_h))^2,
-// and only c is fitted (3 n - 3 dof). Then min_fixes_with_heading fixes that agree suffice (two:
-// one alone could be an outlier that nothing contradicts), the first within about two seconds. Fixes and DVL samples older than max_span_s before
+// and only c is fitted (3 n - 3 dof). Then min_fixes_with_heading fixes suffice: two by default,
+// within about two seconds; one, the first fix, within about a second (it is measured at once and
+// arrives 0.2-1 s late). A fix alone could be an outlier that nothing contradicts, so a state on
+// a single fix has an outlier's size in its position covariance too, unconfirmed_fix_sigma_m per
+// axis: the window's next fixes then pull it to the truth whether the first was good or not (a
+// confident start on an outlier would gate the good fixes after it). One fix is not the default:
+// a single 0.2 m fix breaks the long approach's error target more often than two, and the earlier
+// start met a DVL rate test still locked by the start's tilt (README, "A heading sensor"). Fixes and DVL samples older than max_span_s before
 // the newest fix are forgotten; so is everything before a DVL gap (bottom lock lost, a stop)
 // longer than max_dvl_gap_s, since the path cannot be traced across it.
 //
@@ -68,6 +74,7 @@ struct AcousticInitOptions {
   bool enabled = true;
   int min_fixes = 4;
   int min_fixes_with_heading = 2;  // with a heading sensor
+  double unconfirmed_fix_sigma_m = 2.0;  // added to a start on one fix (an outlier's size)
   double max_span_s = 30.0;
   double max_dvl_gap_s = 1.0;
   double max_heading_sigma_rad = 0.1;  // about 6 degrees
@@ -88,6 +95,7 @@ struct InitialState {
   int fixes_rejected = 0;   // outliers dropped by the fit
   double heading_sigma_rad = 0.0;
   bool heading_measured = false;  // from the heading sensor, not the path
+  bool unconfirmed = false;  // on one fix: its covariance covers an outlier (see above)
 };
 
 class AcousticInitializer {
