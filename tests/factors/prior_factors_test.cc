@@ -1,6 +1,7 @@
 #include <cmath>
 #include <memory>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include <ceres/ceres.h>
@@ -11,6 +12,7 @@
 #include "factors/bias_prior_factor.h"
 #include "factors/pose_manifold.h"
 #include "factors/pose_prior_factor.h"
+#include "factors/scalar_random_walk_factor.h"
 #include "factors/velocity_prior_factor.h"
 
 namespace auvdock {
@@ -194,6 +196,23 @@ TEST(PriorFactorsTest, RejectInvalidCovariancesAndMeans) {
   Pose3 bad;
   bad.p.x() = std::nan("");
   EXPECT_THROW(PosePriorFactor(bad, Matrix6::Identity()), std::invalid_argument);
+}
+
+TEST(ScalarRandomWalkFactorTest, KnownAnswersAndBadInput) {
+  const ScalarRandomWalkFactor walk(0.001, 4.0);  // sigma 0.002 over 4 s
+  EXPECT_DOUBLE_EQ(walk.sigma(), 0.002);
+  const double a = 0.1, b = 0.104;
+  double r = 0.0;
+  ASSERT_TRUE(walk(&a, &b, &r));
+  EXPECT_NEAR(r, 2.0, 1e-12);
+  const ScalarPriorFactor prior(0.0, 0.5);
+  ASSERT_TRUE(prior(&b, &r));
+  EXPECT_NEAR(r, 0.208, 1e-12);
+  EXPECT_THROW(ScalarRandomWalkFactor(0.0, 1.0), std::invalid_argument);
+  EXPECT_THROW(ScalarRandomWalkFactor(0.001, 0.0), std::invalid_argument);
+  EXPECT_THROW(ScalarRandomWalkFactor(std::nan(""), 1.0), std::invalid_argument);
+  EXPECT_THROW(ScalarPriorFactor(std::nan(""), 1.0), std::invalid_argument);
+  EXPECT_THROW(ScalarPriorFactor(0.0, -1.0), std::invalid_argument);
 }
 
 }  // namespace
