@@ -87,8 +87,9 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
   DatasetWriter writer(dir, calibration_, s.dock);
 
   ImuSimulator imu(s.imu, g_D, s.initial_gyro_bias, s.initial_accel_bias, noisy,
-                   MakeRandomStream(s.seed, RandomStreamId::kImu));
-  DepthSimulator depth(s.depth, s.depth_faults, s.dock, noisy, MakeRandomStream(s.seed, RandomStreamId::kDepth));
+                   MakeRandomStream(s.seed, RandomStreamId::kImu), s.imu_errors);
+  DepthSimulator depth(s.depth, s.depth_faults, s.dock, noisy,
+                       MakeRandomStream(s.seed, RandomStreamId::kDepth));
   DvlSimulator dvl(s.dvl, s.dvl_faults, noisy, MakeRandomStream(s.seed, RandomStreamId::kDvl));
   AcousticSimulator acoustic(s.acoustic, s.dock, s.acoustic_faults, noisy,
                              MakeRandomStream(s.seed, RandomStreamId::kAcoustic));
@@ -130,7 +131,9 @@ SimulationSummary DockingSimulator::Run(const std::string& dir, const Cancellati
     for (; k_imu < n_imu && SampleTime(k_imu, s.imu.rate_hz) <= t_end_ns; ++k_imu) {
       const int64_t t = SampleTime(k_imu, s.imu.rate_hz);
       const KinematicState state = trajectory_.At(Seconds(t));
-      writer.AddImu(imu.Sample(t, state));
+      std::optional<FaultRecord> fault;
+      writer.AddImu(imu.Sample(t, state, &fault));
+      record_fault(fault);
       writer.AddGroundTruth({t, state.T_D_B, state.v_D, imu.gyro_bias(), imu.accel_bias()});
       summary.max_speed_mps = std::max(summary.max_speed_mps, state.v_D.norm());
       ++summary.n_imu;

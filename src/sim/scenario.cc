@@ -177,6 +177,14 @@ Scenario LoadScenario(const std::string& path) {
       imu.GetPositive("accelerometer_random_walk", s.imu.accelerometer_random_walk);
   s.initial_gyro_bias = imu.GetVector<3>("initial_gyro_bias", s.initial_gyro_bias);
   s.initial_accel_bias = imu.GetVector<3>("initial_accel_bias", s.initial_accel_bias);
+  const ConfigNode imu_errors = imu.ChildOrEmpty("errors");
+  s.imu_errors.noise_scale = imu_errors.GetPositive("noise_scale", s.imu_errors.noise_scale);
+  s.imu_errors.gyro_scale_factor =
+      imu_errors.GetVector<3>("gyro_scale_factor", s.imu_errors.gyro_scale_factor);
+  s.imu_errors.accel_scale_factor =
+      imu_errors.GetVector<3>("accel_scale_factor", s.imu_errors.accel_scale_factor);
+  s.imu_errors.misalignment_rad =
+      imu_errors.GetVector<3>("misalignment_rad", s.imu_errors.misalignment_rad);
 
   const ConfigNode depth = root.ChildOrEmpty("depth");
   s.depth.rate_hz = depth.GetPositive("rate_hz", s.depth.rate_hz);

@@ -49,7 +49,8 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
   for (CameraCalibration& camera : run.calibration.cameras) camera.pixel_noise_px = pixel_sigma;
 
   ImuSimulator imu(scenario.imu, scenario.dock.gravity_D, scenario.initial_gyro_bias,
-                   scenario.initial_accel_bias, true, MakeRandomStream(seed, 101));
+                   scenario.initial_accel_bias, true, MakeRandomStream(seed, 101),
+                   scenario.imu_errors);
   for (int64_t k = 0;; ++k) {
     const int64_t t = simulator.SampleTime(k, scenario.imu.rate_hz);
     if (simulator.Seconds(t) > scenario.duration_s) break;

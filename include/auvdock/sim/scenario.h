@@ -17,6 +17,7 @@
 #include "auvdock/sim/sbl_simulator.h"
 #include "auvdock/sim/docking_trajectory.h"
 #include "auvdock/sim/dvl_simulator.h"
+#include "auvdock/sim/imu_simulator.h"
 #include "auvdock/sim/render_look.h"
 #include "auvdock/sim/synthetic_detections.h"
 #include "auvdock/sim/underwater_renderer.h"
@@ -61,6 +62,7 @@ struct Scenario {
   RenderRandomization randomize;  // the images' domain randomisation, off by default
 
   ImuCalibration imu;
+  ImuErrorConfig imu_errors;  // scenario key imu.errors: what the estimator does not model
   Eigen::Vector3d initial_gyro_bias = Eigen::Vector3d(0.002, -0.001, 0.0015);   // rad/s
   Eigen::Vector3d initial_accel_bias = Eigen::Vector3d(0.03, -0.02, 0.04);      // m/s^2
   DepthCalibration depth;
