@@ -51,8 +51,11 @@ DvlRateVerdict DvlRateTest::Check(const DvlMeasurement& sample, const ImuBuffer&
   const Eigen::Vector3d v_B = pim->delta_q().conjugate() * (v_B_ref + pim->delta_v()) +
                               q_D_B.conjugate() * gravity_D * dt;
   const Eigen::Vector3d predicted = q_B_S.conjugate() * (v_B + w_B.cross(p_B_S));
-  const double variance = 2.0 * noise_factor_ * calibration_.sigma_mps * calibration_.sigma_mps +
-                          std::pow(options_.accel_sigma_mps2 * dt, 2);
+  const double variance =
+      2.0 * noise_factor_ * calibration_.sigma_mps * calibration_.sigma_mps +
+      (options_.accel_sigma_mps2 * options_.accel_sigma_mps2 +
+       state_accel_sigma_ * state_accel_sigma_) *
+          dt * dt;
   verdict.statistic = (sample.v_S - predicted).squaredNorm() / variance;
   verdict.pass = verdict.statistic <= options_.gate_chi2;
   if (verdict.pass) {

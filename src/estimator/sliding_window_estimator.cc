@@ -271,6 +271,8 @@ void SlidingWindowEstimator::StartWindow(const InitialState& initial) {
       std::pow(options_.init_accel_bias_sigma, 2));
   problem_->AddResidualBlock(BiasPriorFactor::Create(Eigen::Matrix<double, 6, 1>::Zero(), bias_cov),
                              nullptr, state->bias);
+  newest_accel_uncertainty_mps2_ = AccelUncertainty(initial.pose_covariance.block<3, 3>(3, 3),
+                                                    bias_cov.bottomRightCorner<3, 3>());
   if (depth_offset_on_) {
     problem_->AddParameterBlock(state->depth_offset, kDepthOffsetSize);
     problem_->AddResidualBlock(
@@ -505,6 +507,22 @@ void SlidingWindowEstimator::AddDvl(const DvlMeasurement& sample) {
   if (options_.acoustic_init.enabled) acoustic_init_.AddDvl(sample);
 }
 
+double SlidingWindowEstimator::AccelUncertainty(const Eigen::Matrix3d& attitude_covariance,
+                                                const Eigen::Matrix3d& accel_bias_covariance) const {
+  // The tilt: the attitude's rotation about the horizontal axes (dtheta in D), which turns g.
+  const Eigen::Vector3d down = dock_.gravity_D.normalized();
+  const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - down * down.transpose();
+  const double tilt_variance =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P * attitude_covariance * P)
+          .eigenvalues()
+          .maxCoeff();
+  const double bias_variance =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(accel_bias_covariance).eigenvalues().maxCoeff();
+  const double variance =
+      dock_.gravity_D.squaredNorm() * std::max(0.0, tilt_variance) + std::max(0.0, bias_variance);
+  return std::isfinite(variance) ? std::sqrt(variance) : 0.0;
+}
+
 StateBlocks SlidingWindowEstimator::BlocksOf(State& state) const {
   return StateBlocks(state.pose, state.velocity, &imu_, BiasFromBlock(state.bias),
                      depth_offset_on_ ? state.depth_offset : nullptr);
@@ -604,6 +622,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
       shift = ImuShiftFromState(blocks, state->t_ns, sample.t_ns - state->t_ns, dock_.gravity_D);
       if (shift) {
         dvl_rate_test_.SetNoiseFactor(dvl_noise_.factor());
+        dvl_rate_test_.SetStateUncertainty(newest_accel_uncertainty_mps2_);
         const DvlRateVerdict verdict =
             dvl_rate_test_.Check(sample, imu_, blocks.bias,
                                  PoseFromBlock(state->pose).q * shift->delta_q, dock_.gravity_D);
@@ -684,6 +703,10 @@ std::optional<Eigen::MatrixXd> SlidingWindowEstimator::PoseCovariance(const Stat
     const Eigen::Index k = last->covariance->rows() - 1;
     newest_depth_offset_variance_ = (*last->covariance)(k, k);
   }
+  newest_accel_uncertainty_mps2_ = AccelUncertainty(
+      last->covariance->block<3, 3>(3, 3),
+      last->covariance->block<3, 3>(kPoseTangentSize + kVelocitySize + 3,
+                                    kPoseTangentSize + kVelocitySize + 3));
   return last->covariance->topLeftCorner(kPoseTangentSize, kPoseTangentSize).eval();
 }
 

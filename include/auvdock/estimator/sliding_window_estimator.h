@@ -438,6 +438,10 @@ class SlidingWindowEstimator {
                                             const AddFactor& add, double max_before_s = 0.0);
   // The state's blocks for the measurement factors (estimator/state_blocks.h).
   StateBlocks BlocksOf(State& state) const;
+  // sqrt(|g|^2 lambda_max(tilt covariance) + lambda_max(accelerometer bias covariance)), m/s^2:
+  // the attitude covariance's part about the horizontal axes (dtheta in D) turns g.
+  double AccelUncertainty(const Eigen::Matrix3d& attitude_covariance,
+                          const Eigen::Matrix3d& accel_bias_covariance) const;
   // Why the frame's per-frame pose may not start the window (init_max_tilt_error_rad), or empty;
   // empty too when fewer than 3 accelerometer samples lie in init_tilt_window_s before it.
   std::string TiltRefusal(const VisionFrame& frame) const;
@@ -500,6 +504,10 @@ class SlidingWindowEstimator {
   // (for the DVL's admission test); empty when not computed.
   std::optional<Eigen::Matrix<double, 9, 9>> newest_pose_velocity_covariance_;
   std::optional<double> newest_depth_offset_variance_;  // with the above
+  // The newest state's uncertainty of g in B (tilt) and of the accelerometer bias, as one sigma
+  // in m/s^2 (AccelUncertainty): the DVL rate test's prediction leans on both. From the start's
+  // priors until the first covariance.
+  double newest_accel_uncertainty_mps2_ = 0.0;
   // estimate_depth_offset with a depth sensor in use: every state has its offset block.
   bool depth_offset_on_ = false;
   std::string init_refusal_;
