@@ -506,7 +506,8 @@ class SlidingWindowEstimator {
   std::optional<double> newest_depth_offset_variance_;  // with the above
   // The newest state's uncertainty of g in B (tilt) and of the accelerometer bias, as one sigma
   // in m/s^2 (AccelUncertainty): the DVL rate test's prediction leans on both. From the start's
-  // priors until the first covariance.
+  // priors until the first covariance (with compute_covariance off it keeps the start's value,
+  // and the rate test stays as wide as at the start).
   double newest_accel_uncertainty_mps2_ = 0.0;
   // estimate_depth_offset with a depth sensor in use: every state has its offset block.
   bool depth_offset_on_ = false;
