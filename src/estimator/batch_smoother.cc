@@ -21,8 +21,8 @@
 #include "auvdock/estimator/vision_factors.h"
 #include "factors/bias_prior_factor.h"
 #include "factors/imu_preintegration_factor.h"
-#include "factors/pose_manifold.h"
 #include "factors/depth_offset_factor.h"
+#include "factors/pose_manifold.h"
 #include "factors/pose_prior_factor.h"
 #include "factors/scalar_random_walk_factor.h"
 #include "factors/velocity_prior_factor.h"
@@ -238,8 +238,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   problem_options.enable_fast_removal = true;
   ceres::Problem problem(problem_options);
   const PoseManifold manifold;
-  const bool with_depth_offset = estimator_options.estimate_depth_offset &&
-                                 estimator_options.use_depth && calibration.depth.has_value();
+  const bool with_depth_offset = EstimatesDepthOffset(estimator_options, calibration);
   for (size_t k = 0; k < states.size(); ++k) {
     BatchState* s = states[k].get();
     problem.AddParameterBlock(s->pose, kPoseSize, const_cast<PoseManifold*>(&manifold));

@@ -116,7 +116,7 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
   rig_.stereo_right = calibration_.FindCameraByRole(CameraRole::kStereoRight);
   rig_.mono = calibration_.FindCameraByRole(CameraRole::kMono);
   rig_.dock = &dock_;
-  depth_offset_on_ = options_.estimate_depth_offset && options_.use_depth && calibration_.depth;
+  depth_offset_on_ = EstimatesDepthOffset(options_, calibration_);
   Reset("");
   stats_.resets = 0;
   stats_.log.clear();
@@ -661,9 +661,7 @@ std::vector<SensorResidual> SlidingWindowEstimator::AttachDvl(int64_t t_ns) {
 void SlidingWindowEstimator::MarginalizeOldest() {
   State& oldest = *window_.front();
   history_.push_back(oldest.Record());
-  std::vector<double*> blocks = {oldest.pose, oldest.velocity, oldest.bias};
-  if (depth_offset_on_) blocks.push_back(oldest.depth_offset);
-  LinearizedPrior prior = MarginalizeOut(problem_.get(), blocks);
+  LinearizedPrior prior = MarginalizeOut(problem_.get(), ParameterBlocks(oldest));
   window_.pop_front();
   if (!prior.blocks.empty()) {
     auto* factor = new MarginalizationFactor(std::move(prior));
@@ -671,13 +669,16 @@ void SlidingWindowEstimator::MarginalizeOldest() {
   }
 }
 
+std::vector<double*> SlidingWindowEstimator::ParameterBlocks(State& state) const {
+  std::vector<double*> blocks = {state.pose, state.velocity, state.bias};
+  if (depth_offset_on_) blocks.push_back(state.depth_offset);
+  return blocks;
+}
+
 std::vector<std::vector<double*>> SlidingWindowEstimator::StateBlocksInOrder() const {
   std::vector<std::vector<double*>> states;
   states.reserve(window_.size());
-  for (const auto& s : window_) {
-    states.push_back({s->pose, s->velocity, s->bias});
-    if (depth_offset_on_) states.back().push_back(s->depth_offset);
-  }
+  for (const auto& s : window_) states.push_back(ParameterBlocks(*s));
   return states;
 }
 

@@ -278,6 +278,12 @@ struct EstimatorOptions {
   AcousticInitOptions acoustic_init;
 };
 
+// Whether the states carry the depth sensor's offset (estimate_depth_offset, with the depth in
+// use and a depth sensor in the calibration): the window and the batch smoother alike.
+inline bool EstimatesDepthOffset(const EstimatorOptions& options, const Calibration& calibration) {
+  return options.estimate_depth_offset && options.use_depth && calibration.depth.has_value();
+}
+
 // The estimate at one state.
 struct EstimatorOutput {
   int64_t t_ns = 0;
@@ -419,7 +425,9 @@ class SlidingWindowEstimator {
   // stop_early: stop once a step lowers the cost by less than solver_cost_tolerance. The chain
   // solver when the window is a chain and chain_solver is on, Ceres otherwise.
   bool Solve(bool stop_early = true);
-  // Each window state's blocks (pose, velocity, bias), oldest first.
+  // One state's parameter blocks: pose, velocity, bias, and the depth offset when estimated.
+  std::vector<double*> ParameterBlocks(State& state) const;
+  // Each window state's blocks (ParameterBlocks), oldest first.
   std::vector<std::vector<double*>> StateBlocksInOrder() const;
   void MarginalizeOldest();
   // The pending depth samples up to t_ns onto the states at or before them; returns the
