@@ -1,6 +1,6 @@
 // auvdock detect --images "DIR/*.jpg" --calib FILE [--camera NAME] --dock FILE --out DIR
 //                [--overlay] [--labels FILE [--label-max-range M]] [--colour C] [--deinterlace]
-//                [--no-tracking] [--no-second-look] [--keep-unexplained]
+//                [--no-tracking] [--no-second-look] [--keep-unexplained] [--bridge B]
 //                [--gravity-camera X Y Z] [--min-halo-excess GRAY]
 //
 // A first look at one's own footage: the real-water light detector, the identification and the
@@ -10,8 +10,14 @@
 // colour threshold is learned from the identified lights (HaloColourLearner) unless given. The
 // detections that an image's pose leaves unidentified, far from every light it puts in the image
 // (MonoLightPipeline step 6), are reported as rejected candidates ("not a light of the dock at
-// the pose"), not as detections; --keep-unexplained keeps them. Writes,
-// flushed frame by frame (a stopped run keeps every frame written before the stop):
+// the pose"), not as detections; --keep-unexplained keeps them. At the end of the images, the
+// frames without a pose are bridged from the runs of posed frames before and after them
+// (two_way_light_bridge.h; --bridge forward: from the frames before only, as a live system could;
+// off): the lights such a walk identifies get their ids, and what it finds far from every light
+// is rejected ("not a light of the dock at the neighbouring frames' pose"); their reason in
+// frames.csv says so. Writes, flushed frame by frame (a stopped run keeps every frame written
+// before the stop, unbridged), and written anew from memory after bridging (each file to a
+// temporary, renamed over the old one; the overlays of the bridged frames are drawn again):
 //   OUTDIR/detections.csv  frame,image,light_id,u,v,radius,score,cov_uu,cov_uv,cov_vv,at_border
 //                          (light_id -1: not identified; covariance in px^2)
 //   OUTDIR/frames.csv      frame,image,detections,identified,status,tracked,rms_px,sigma_px,
@@ -38,6 +44,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -58,6 +65,7 @@
 #include "auvdock/io/staged_directory.h"
 #include "auvdock/vision/mono_light_pipeline.h"
 #include "auvdock/vision/pnp_solver.h"
+#include "auvdock/vision/two_way_light_bridge.h"
 
 namespace fs = std::filesystem;
 
@@ -78,11 +86,94 @@ struct DetectOptions {
   bool no_second_look = false;
   bool keep_unexplained = false;
   bool quiet = false;
+  std::string bridge = "both";
   std::vector<double> gravity_camera;
   double min_halo_excess = -1.0;  // < 0: learned from the identified lights
   double label_max_range_m = -1.0;  // < 0: every ok label is required
 };
 
+
+// One image's output, kept for the walks from the posed frames beside it (which may revise its
+// labels at the end of the run).
+struct FrameRecord {
+  int index = 0;
+  std::string path, name;
+  std::vector<LightDetection> detections;
+  std::vector<int> light_ids;  // per detection
+  std::optional<Pose3> T_C_D;
+  Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
+  double residual_sigma_px = 0.0;  // the pose's residual per axis, a posteriori
+  std::string status_columns;  // frames.csv from status to qw
+  std::string symmetry, reason;  // without commas
+  std::vector<RejectedLightCandidate> rejected;  // kept with --overlay only
+};
+
+// detections.csv, frames.csv and (--overlay) rejected.csv: written frame by frame, and written
+// anew (each to a temporary file, then renamed over the old one) when the walks revised labels.
+class FrameOutput {
+ public:
+  FrameOutput(const std::string& out, bool overlay) : out_(out), overlay_(overlay) {
+    Open("", &detections_, &frames_, &rejected_);
+  }
+
+  void Write(const FrameRecord& r) { Write(r, &detections_, &frames_, &rejected_); }
+
+  void Rewrite(const std::vector<FrameRecord>& records) {
+    CsvWriter detections, frames, rejected;
+    Open(".tmp", &detections, &frames, &rejected);
+    for (const FrameRecord& r : records) Write(r, &detections, &frames, &rejected);
+    detections.Close();
+    frames.Close();
+    rejected.Close();
+    detections_.Close();
+    frames_.Close();
+    rejected_.Close();
+    for (const char* name : {"/detections.csv", "/frames.csv", "/rejected.csv"}) {
+      if (fs::exists(out_ + name + std::string(".tmp"))) {
+        fs::rename(out_ + name + std::string(".tmp"), out_ + name);
+      }
+    }
+  }
+
+ private:
+  void Open(const std::string& suffix, CsvWriter* detections, CsvWriter* frames,
+            CsvWriter* rejected) const {
+    *detections = CsvWriter(out_ + "/detections.csv" + suffix,
+                            "frame,image,light_id,u,v,radius,score,cov_uu,cov_uv,cov_vv,at_border");
+    *frames = CsvWriter(out_ + "/frames.csv" + suffix,
+                        "frame,image,detections,identified,status,tracked,rms_px,sigma_px,tx,ty,"
+                        "tz,qx,qy,qz,qw,symmetry,reason");
+    if (overlay_) {
+      *rejected = CsvWriter(out_ + "/rejected.csv" + suffix, "frame,image,u,v,sigma,reason");
+    }
+  }
+
+  void Write(const FrameRecord& r, CsvWriter* detections, CsvWriter* frames,
+             CsvWriter* rejected) const {
+    const std::string head = std::to_string(r.index) + "," + r.name + ",";
+    int identified = 0;
+    for (size_t i = 0; i < r.detections.size(); ++i) {
+      const LightDetection& d = r.detections[i];
+      identified += r.light_ids[i] >= 0;
+      detections->Line(head + std::to_string(r.light_ids[i]) + "," + FormatDouble(d.uv.x()) + "," +
+                       FormatDouble(d.uv.y()) + "," + FormatDouble(d.radius_px) + "," +
+                       FormatDouble(d.score) + "," + FormatDouble(d.covariance(0, 0)) + "," +
+                       FormatDouble(d.covariance(0, 1)) + "," + FormatDouble(d.covariance(1, 1)) +
+                       "," + (d.at_border ? "1" : "0"));
+    }
+    frames->Line(head + std::to_string(r.detections.size()) + "," + std::to_string(identified) +
+                 "," + r.status_columns + "," + r.symmetry + "," + r.reason);
+    if (!overlay_) return;
+    for (const RejectedLightCandidate& c : r.rejected) {
+      rejected->Line(head + FormatDouble(c.uv.x()) + "," + FormatDouble(c.uv.y()) + "," +
+                     FormatDouble(c.sigma_px) + "," + c.reason);
+    }
+  }
+
+  std::string out_;
+  bool overlay_;
+  CsvWriter detections_, frames_, rejected_;
+};
 
 void DrawOverlay(const cv::Mat& image, const std::vector<LightDetection>& detections,
                  const std::vector<int>& ids, const std::vector<RejectedLightCandidate>& rejected,
@@ -157,26 +248,17 @@ void RunDetect(const DetectOptions& options) {
   RequireAbsentOrEmptyDirectory(options.out);
   fs::create_directories(options.out);
   if (options.overlay) fs::create_directories(options.out + "/overlay");
-  CsvWriter detections_csv(
-      options.out + "/detections.csv",
-      "frame,image,light_id,u,v,radius,score,cov_uu,cov_uv,cov_vv,at_border");
-  CsvWriter frames_csv(options.out + "/frames.csv",
-                       "frame,image,detections,identified,status,tracked,rms_px,sigma_px,tx,ty,tz,"
-                       "qx,qy,qz,qw,symmetry,reason");
-  CsvWriter rejected_csv;
-  if (options.overlay) {
-    rejected_csv = CsvWriter(options.out + "/rejected.csv", "frame,image,u,v,sigma,reason");
-  }
+  FrameOutput output(options.out, options.overlay);
+  std::vector<FrameRecord> records;
   CsvWriter pose_covariance_csv(options.out + "/camera_pose_covariance.csv",
                                 PoseCovarianceCsvHeader());
   std::ofstream poses(options.out + "/camera_poses.tum");
   poses << "# timestamp tx ty tz qx qy qz qw (T_D_C: the camera in the dock frame)\n";
 
   const CancellationToken cancel = InstallSignalCancellation();
-  std::map<std::string, FrameDetections> evaluated;
   std::map<std::string, int> reasons;
   std::map<std::string, int> rejected_reasons;  // every image's rejected candidates, by kind
-  int n_frames = 0, n_pose = 0, n_tracked = 0, n_detections = 0, n_no_detection = 0;
+  int n_frames = 0, n_pose = 0, n_tracked = 0, n_no_detection = 0;
   int n_guided = 0, n_weak_pass = 0;
   double detect_s = 0.0, pose_s = 0.0;
   bool interrupted = false;
@@ -202,40 +284,41 @@ void RunDetect(const DetectOptions& options) {
                        " (give --colour white to detect without colour)");
     }
     MonoLightFrame frame = pipeline.Process(image);
-    const std::vector<LightDetection>& detections = frame.detections;
     const MonoPoseResult& pose = frame.pose;
-    std::vector<RejectedLightCandidate> rejected = frame.rejected;
-    for (const LightDetection& d : frame.unexplained) {
-      rejected.push_back({d.uv, d.radius_px, "not a light of the dock at the pose"});
+    FrameRecord record;
+    record.index = static_cast<int>(f);
+    record.path = path;
+    record.name = name;
+    record.detections = frame.detections;
+    record.light_ids = pose.light_ids;
+    record.T_C_D = pose.T_C_D;
+    record.covariance_local = pose.covariance_local;
+    if (pose.T_C_D && pose.num_lights > 3) {
+      record.residual_sigma_px =
+          pose.rms_px * std::sqrt(pose.num_lights / (2.0 * pose.num_lights - 6.0));
     }
+    record.rejected = std::move(frame.rejected);
+    for (const LightDetection& d : frame.unexplained) {
+      record.rejected.push_back({d.uv, d.radius_px, "not a light of the dock at the pose"});
+    }
+    const std::vector<LightDetection>& detections = record.detections;
+    const std::vector<RejectedLightCandidate>& rejected = record.rejected;
     detect_s += frame.detect_s;
     pose_s += frame.identify_s;
     ++n_frames;
-    n_detections += static_cast<int>(detections.size());
     n_guided += frame.guided_detections;
     n_weak_pass += frame.from_weak_pass;
     if (detections.empty()) ++n_no_detection;
 
-    int identified = 0;
-    for (size_t i = 0; i < detections.size(); ++i) {
-      const LightDetection& d = detections[i];
-      identified += pose.light_ids[i] >= 0;
-      detections_csv.Line(std::to_string(f) + "," + name + "," + std::to_string(pose.light_ids[i]) +
-                          "," + FormatDouble(d.uv.x()) + "," + FormatDouble(d.uv.y()) + "," +
-                          FormatDouble(d.radius_px) + "," + FormatDouble(d.score) + "," +
-                          FormatDouble(d.covariance(0, 0)) + "," + FormatDouble(d.covariance(0, 1)) +
-                          "," + FormatDouble(d.covariance(1, 1)) + "," + (d.at_border ? "1" : "0"));
-    }
-    std::string row = std::to_string(f) + "," + name + "," + std::to_string(detections.size()) +
-                      "," + std::to_string(identified) + "," +
-                      (pose.T_C_D ? "ok" : MatchStatusName(pose.status)) + "," +
-                      (pose.tracked ? "1" : "0") + ",";
+    record.status_columns = std::string(pose.T_C_D ? "ok" : MatchStatusName(pose.status)) + "," +
+                            (pose.tracked ? "1" : "0") + ",";
     if (pose.T_C_D) {
       const Pose3& T = *pose.T_C_D;
-      row += FormatDouble(pose.rms_px) + "," + FormatDouble(pose.pixel_sigma_px) + "," +
-             FormatDouble(T.p.x()) + "," + FormatDouble(T.p.y()) + "," + FormatDouble(T.p.z()) +
-             "," + FormatDouble(T.q.x()) + "," + FormatDouble(T.q.y()) + "," +
-             FormatDouble(T.q.z()) + "," + FormatDouble(T.q.w());
+      record.status_columns += FormatDouble(pose.rms_px) + "," + FormatDouble(pose.pixel_sigma_px) +
+                               "," + FormatDouble(T.p.x()) + "," + FormatDouble(T.p.y()) + "," +
+                               FormatDouble(T.p.z()) + "," + FormatDouble(T.q.x()) + "," +
+                               FormatDouble(T.q.y()) + "," + FormatDouble(T.q.z()) + "," +
+                               FormatDouble(T.q.w());
       const Pose3 T_D_C = T.Inverse();
       char line[256];
       std::snprintf(line, sizeof(line), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n",
@@ -248,7 +331,7 @@ void RunDetect(const DetectOptions& options) {
       ++n_pose;
       n_tracked += pose.tracked;
     } else {
-      row += ",,,,,,,,";
+      record.status_columns += ",,,,,,,,";
       ++reasons[ReasonClass(pose.reason)];
     }
     // Why the detector found too few lights: its rejected candidates, by kind (a wrong colour
@@ -259,35 +342,95 @@ void RunDetect(const DetectOptions& options) {
       ++rejected_here[kind];
       ++rejected_reasons[kind];
     }
-    std::string reason = pose.reason;
+    record.reason = pose.reason;
     if (!pose.T_C_D && !rejected_here.empty() &&
         static_cast<int>(detections.size()) < pipeline_options.poser.min_lights) {
       const auto most = std::max_element(
           rejected_here.begin(), rejected_here.end(),
           [](const auto& a, const auto& b) { return a.second < b.second; });
-      reason += " (" + std::to_string(rejected.size()) + " candidates rejected; most often: " +
-                most->first + ")";
+      record.reason += " (" + std::to_string(rejected.size()) + " candidates rejected; most often: " +
+                       most->first + ")";
     }
-    std::replace(reason.begin(), reason.end(), ',', ';');
-    std::string symmetry = pose.symmetry_note;
-    std::replace(symmetry.begin(), symmetry.end(), ',', ';');
-    frames_csv.Line(row + "," + symmetry + "," + reason);
+    std::replace(record.reason.begin(), record.reason.end(), ',', ';');
+    record.symmetry = pose.symmetry_note;
+    std::replace(record.symmetry.begin(), record.symmetry.end(), ',', ';');
+    output.Write(record);
     if (options.overlay) {
-      for (const RejectedLightCandidate& r : rejected) {
-        rejected_csv.Line(std::to_string(f) + "," + name + "," + FormatDouble(r.uv.x()) + "," +
-                          FormatDouble(r.uv.y()) + "," + FormatDouble(r.sigma_px) + "," + r.reason);
-      }
-      DrawOverlay(image, detections, pose.light_ids, rejected,
+      DrawOverlay(image, detections, record.light_ids, rejected,
                   options.out + "/overlay/" + fs::path(name).stem().string() + ".png");
     }
-    FrameDetections& e = evaluated[name];
-    for (const LightDetection& d : detections) e.uv.push_back(d.uv);
-    e.has_pose = pose.T_C_D.has_value();
+    if (!options.overlay) record.rejected.clear();  // only rejected.csv needs them later
+    records.push_back(std::move(record));
     if (!options.quiet && n_frames % 25 == 0) {
       std::fprintf(stderr, "\rdetect: %d/%zu images", n_frames, files.size());
     }
   }
   if (!options.quiet) std::fprintf(stderr, "\n");
+
+  // The frames without a pose, from the posed frames beside them (two_way_light_bridge.h); the
+  // files written frame by frame are then written anew with what the walks identified.
+  int n_bridged = 0, n_bridge_identified = 0, n_bridge_unexplained = 0;
+  if (!interrupted && options.bridge != "off" && !options.no_tracking) {
+    std::vector<BridgedFrame> frames(records.size());
+    for (size_t k = 0; k < records.size(); ++k) {
+      frames[k].detections = records[k].detections;
+      frames[k].T_C_D = records[k].T_C_D;
+      frames[k].covariance_local = records[k].covariance_local;
+      frames[k].residual_sigma_px = records[k].residual_sigma_px;
+    }
+    TwoWayLightBridgeOptions bridge_options;
+    bridge_options.backward = options.bridge == "both";
+    bridge_options.tracker.pixel_noise_px = camera.pixel_noise_px;
+    n_bridged = BridgeFramesWithoutPose(camera.intrinsics, dock, 1.0 / camera.rate_hz,
+                                        bridge_options, &frames);
+    for (size_t k = 0; k < records.size(); ++k) {
+      if (!frames[k].bridged) continue;
+      FrameRecord& record = records[k];
+      std::vector<LightDetection> kept;
+      std::vector<int> ids;
+      std::vector<RejectedLightCandidate> unexplained;
+      int identified = 0;
+      for (size_t i = 0; i < record.detections.size(); ++i) {
+        if (frames[k].unexplained[i] && !options.keep_unexplained) {
+          unexplained.push_back({record.detections[i].uv, record.detections[i].radius_px,
+                                 "not a light of the dock at the neighbouring frames' pose"});
+          continue;
+        }
+        kept.push_back(record.detections[i]);
+        ids.push_back(frames[k].light_ids[i]);
+        identified += ids.back() >= 0;
+      }
+      n_bridge_identified += identified;
+      n_bridge_unexplained += static_cast<int>(unexplained.size());
+      const int anchor_frame = records[frames[k].anchor_frame].index;
+      record.reason += "; " + std::to_string(identified) + " identified and " +
+                       std::to_string(unexplained.size()) +
+                       " unexplained by the poses of the frames from " +
+                       std::to_string(anchor_frame) + (anchor_frame > record.index ? " back" : " on");
+      record.detections = std::move(kept);
+      record.light_ids = std::move(ids);
+      for (const RejectedLightCandidate& r : unexplained) {
+        ++rejected_reasons["not a light of the dock at the neighbouring frames' pose"];
+        if (options.overlay) record.rejected.push_back(r);
+      }
+      if (options.overlay && (!unexplained.empty() || identified > 0)) {
+        const cv::Mat image = cv::imread(record.path, cv::IMREAD_UNCHANGED);
+        if (!image.empty()) {
+          DrawOverlay(image, record.detections, record.light_ids, record.rejected,
+                      options.out + "/overlay/" + fs::path(record.name).stem().string() + ".png");
+        }
+      }
+    }
+    if (n_bridged > 0) output.Rewrite(records);
+  }
+  int n_detections = 0;
+  std::map<std::string, FrameDetections> evaluated;
+  for (const FrameRecord& record : records) {
+    n_detections += static_cast<int>(record.detections.size());
+    FrameDetections& e = evaluated[record.name];
+    for (const LightDetection& d : record.detections) e.uv.push_back(d.uv);
+    e.has_pose = record.T_C_D.has_value();
+  }
 
   nlohmann::ordered_json summary;
   summary["images"] = files.size();
@@ -297,6 +440,9 @@ void RunDetect(const DetectOptions& options) {
   summary["frames_tracked"] = n_tracked;
   summary["frames_without_detection"] = n_no_detection;
   summary["detections"] = n_detections;
+  summary["bridged_frames"] = {{"frames", n_bridged},
+                               {"identified", n_bridge_identified},
+                               {"unexplained", n_bridge_unexplained}};
   summary["second_look"] = {{"guided_detections", n_guided}, {"frames_posed_by_weak_pass", n_weak_pass}};
   summary["colour"] = LightColourName(colour);
   summary["no_pose_reasons"] = reasons;
@@ -311,6 +457,11 @@ void RunDetect(const DetectOptions& options) {
               options.out.c_str(), n_pose, n_tracked, n_detections);
   for (const auto& [reason, count] : reasons) {
     std::printf("  no pose: %d x %s\n", count, reason.c_str());
+  }
+  if (n_bridged > 0) {
+    std::printf("  %d frames without a pose bridged by their neighbours' poses: %d lights "
+                "identified, %d detections no light of the dock\n",
+                n_bridged, n_bridge_identified, n_bridge_unexplained);
   }
   if (!rejected_reasons.empty()) {
     std::vector<std::pair<int, std::string>> by_count;
@@ -387,10 +538,15 @@ void AddDetectCommand(CLI::App& root) {
   sub->add_flag("--overlay", options->overlay, "Write each image with the detections drawn");
   sub->add_flag("--deinterlace", options->deinterlace,
                 "Interlaced video: detect on the even field, line-doubled");
-  sub->add_flag("--no-tracking", options->no_tracking, "Identify every image from scratch");
+  sub->add_flag("--no-tracking", options->no_tracking, "Identify every image from scratch (and no --bridge)");
   sub->add_flag("--keep-unexplained", options->keep_unexplained,
                 "Report as detections what an image's pose leaves unidentified far from every "
                 "light it predicts (by default: rejected, 'not a light of the dock at the pose')");
+  sub->add_option("--bridge", options->bridge,
+                  "Frames without a pose: identify their lights from the posed frames around "
+                  "them (both: before and after, forward: before only, as a live system could; "
+                  "off)")
+      ->check(CLI::IsMember({"both", "forward", "off"}));
   sub->add_flag("--no-second-look", options->no_second_look,
                 "Only the full-image pass: no search where the pose puts the missed lights, no "
                 "laxer pass over an image without a pose");

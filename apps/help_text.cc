@@ -119,6 +119,8 @@ std::string DetectHelp() {
          "Writes into --out: detections.csv (with identities), frames.csv (per image: status,\n"
          "pose, reason), camera_poses.tum (T_D_C), summary.json; with --overlay overlay/*.png\n"
          "and rejected.csv; with --labels, recall, precision and centroid RMS in summary.json.\n"
+         "Images with too few lights for a pose are identified at the end from the posed images\n"
+         "before and after them (--bridge; the files are then written anew).\n"
          "Example: auvdock detect --images \"frames/*.jpg\" --calib calib.yaml --dock dock.yaml "
          "--out out/detect --overlay\n";
 }

@@ -15,7 +15,6 @@ Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   return m;
 }
 
-// d pi / d p_C by central differences (the distortion model is the camera's business).
 Eigen::Matrix<double, 2, 3> ProjectionJacobian(const PinholeRadtanCamera& camera,
                                                const Eigen::Vector3d& p_C) {
   Eigen::Matrix<double, 2, 3> J = Eigen::Matrix<double, 2, 3>::Zero();
@@ -34,6 +33,15 @@ Eigen::Matrix<double, 2, 3> ProjectionJacobian(const PinholeRadtanCamera& camera
 
 }  // namespace
 
+Eigen::Matrix<double, 2, 6> ProjectionPoseJacobian(const PinholeRadtanCamera& camera,
+                                                   const Pose3& T_C_D, const Eigen::Vector3d& p_D) {
+  const Eigen::Vector3d Rp = T_C_D.q * p_D;
+  Eigen::Matrix<double, 3, 6> dp;
+  dp.leftCols<3>() = -Skew(Rp);
+  dp.rightCols<3>() = Eigen::Matrix3d::Identity();
+  return ProjectionJacobian(camera, Rp + T_C_D.p) * dp;
+}
+
 std::vector<PredictedLight> PredictLights(const DockModel& dock, const PinholeRadtanCamera& camera,
                                           const Pose3& T_C_D,
                                           const Eigen::Matrix<double, 6, 6>& covariance_local,
@@ -48,10 +56,7 @@ std::vector<PredictedLight> PredictLights(const DockModel& dock, const PinholeRa
     if (!(p_C.z() > min_depth_m)) continue;
     const auto uv = camera.Project(p_C, min_depth_m);
     if (!uv || !camera.InImage(*uv, margin_px)) continue;
-    Eigen::Matrix<double, 3, 6> dp;
-    dp.leftCols<3>() = -Skew(Rp);
-    dp.rightCols<3>() = Eigen::Matrix3d::Identity();
-    const Eigen::Matrix<double, 2, 6> J = ProjectionJacobian(camera, p_C) * dp;
+    const Eigen::Matrix<double, 2, 6> J = ProjectionPoseJacobian(camera, T_C_D, light.p_D);
     PredictedLight p;
     p.light_id = light.id;
     p.uv = *uv;

@@ -49,8 +49,10 @@ struct Footage {
 
 // Frames of the ring, the camera looking down from 3 m, drifting and turning slowly. With
 // faded_light, that light is a dim blue blob from frame 1 on (below the full-image response), and
-// a blue LED that is not the dock's shines beside the ring (a lamp on the deck, say).
-void MakeFootage(Footage* footage, int frames, int faded_light = -1) {
+// a blue LED that is not the dock's shines beside the ring (a lamp on the deck, say). From frame
+// partial_from on, only the dock file's first two lights are drawn (the rest out of the beam),
+// and the lamp.
+void MakeFootage(Footage* footage, int frames, int faded_light = -1, int partial_from = -1) {
   DockModel dock = LoadDockModel(std::string(AUVDOCK_SOURCE_DIR) + "/data/docks/ring_8.yaml");
   dock.light_colour = "blue";
   SaveDockModel(dock, footage->dir / "dock.yaml");
@@ -63,7 +65,9 @@ void MakeFootage(Footage* footage, int frames, int faded_light = -1) {
                       Eigen::Vector3d(0.1 * std::cos(a), -0.05 + 0.01 * f, 3.0 - 0.02 * f));
     cv::Mat image(480, 640, CV_32FC3, cv::Scalar(30, 95, 90));
     std::vector<std::pair<int, Eigen::Vector2d>> seen;
+    const bool partial = partial_from >= 0 && f >= partial_from;
     for (const DockLight& light : dock.lights) {
+      if (partial && seen.size() == 2) break;
       const Eigen::Vector3d p = T_C_D * light.p_D;
       const Eigen::Vector2d uv(kF * p.x() / p.z() + kCx, kF * p.y() / p.z() + kCy);
       seen.emplace_back(light.id, uv);
@@ -79,7 +83,9 @@ void MakeFootage(Footage* footage, int frames, int faded_light = -1) {
       }
       test::AddLed({uv, 3.0, 7.0}, &image);
     }
-    if (faded_light >= 0) test::AddLed({Eigen::Vector2d(560.0, 420.0), 3.0, 7.0}, &image);
+    if (faded_light >= 0 || partial) {
+      test::AddLed({Eigen::Vector2d(560.0, 420.0), 3.0, 7.0}, &image);
+    }
     cv::Mat bgr;
     image.convertTo(bgr, CV_8UC3);
     char name[32];
@@ -190,6 +196,69 @@ TEST(DetectCli, TheSecondLookFindsAFadedLightAndWhatThePoseDoesNotExplainIsRejec
   EXPECT_EQ(summary["labels"]["recall"], 1.0);
   EXPECT_LT(summary["labels"]["precision"].get<double>(), 1.0);
   EXPECT_FALSE(summary["rejected_candidates"].contains("not a light of the dock at the pose"));
+}
+
+// Two of the ring's LEDs and a lamp after 8 frames of the whole ring: too few for a pose, but
+// the walk from the posed frames identifies the two (with the ids they had) and rejects the lamp;
+// --bridge off leaves all three unidentified.
+TEST(DetectCli, FramesWithTooFewLightsForAPoseAreIdentifiedFromTheFramesBefore) {
+  Footage footage;
+  std::filesystem::create_directories(footage.dir / "frames");
+  MakeFootage(&footage, 12, /*faded_light=*/-1, /*partial_from=*/8);
+  const std::string out = footage.dir / "out";
+  test::CommandResult r = test::RunAuvdock(DetectArgs(footage, out));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  nlohmann::json summary = nlohmann::json::parse(test::ReadTextFile(out + "/summary.json"));
+  EXPECT_EQ(summary["frames_with_pose"], 8);
+  EXPECT_EQ(summary["bridged_frames"]["frames"], 4);
+  EXPECT_EQ(summary["bridged_frames"]["identified"], 8);
+  EXPECT_EQ(summary["bridged_frames"]["unexplained"], 4);
+  EXPECT_EQ(summary["labels"]["recall"], 1.0);
+  EXPECT_EQ(summary["labels"]["precision"], 1.0);
+  EXPECT_NE(r.out.find("4 frames without a pose bridged"), std::string::npos) << r.out;
+  // Each light keeps the id it had in the posed frames.
+  std::map<int, int> reported_of_true;
+  std::ifstream detections(out + "/detections.csv");
+  std::string line;
+  std::getline(detections, line);
+  while (std::getline(detections, line)) {
+    std::stringstream s(line);
+    std::string frame, image, id, u, v;
+    std::getline(s, frame, ',');
+    std::getline(s, image, ',');
+    std::getline(s, id, ',');
+    std::getline(s, u, ',');
+    std::getline(s, v, ',');
+    const Eigen::Vector2d uv(std::stod(u), std::stod(v));
+    int truth = -1;
+    for (const auto& [true_id, p] : footage.truth[std::stoi(frame)]) {
+      if ((p - uv).norm() < 1.0) truth = true_id;
+    }
+    ASSERT_GE(truth, 0) << line;
+    ASSERT_GE(std::stoi(id), 0) << line;
+    const auto [it, inserted] = reported_of_true.emplace(truth, std::stoi(id));
+    EXPECT_EQ(it->second, std::stoi(id)) << "light " << truth << " changed identity: " << line;
+  }
+  // Every bridged frame says so, and the lamp is a rejected candidate with the reason.
+  const std::string frames = test::ReadTextFile(out + "/frames.csv");
+  const std::string note = "2 identified and 1 unexplained by the poses of the frames from 7 on";
+  size_t said = 0;
+  for (size_t at = frames.find(note); at != std::string::npos; at = frames.find(note, at + 1)) {
+    ++said;
+  }
+  EXPECT_EQ(said, 4u) << frames;
+  EXPECT_NE(test::ReadTextFile(out + "/rejected.csv")
+                .find("not a light of the dock at the neighbouring frames' pose"),
+            std::string::npos);
+
+  const std::string off = footage.dir / "off";
+  std::vector<std::string> args = DetectArgs(footage, off);
+  args.insert(args.end(), {"--bridge", "off"});
+  r = test::RunAuvdock(args);
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  summary = nlohmann::json::parse(test::ReadTextFile(off + "/summary.json"));
+  EXPECT_EQ(summary["bridged_frames"]["frames"], 0);
+  EXPECT_NEAR(summary["labels"]["precision"].get<double>(), 1.0 - 4.0 / (8 * 8 + 4 * 3), 1e-9);
 }
 
 TEST(DetectCli, GravityResolvesAnUprightRing) {

@@ -59,6 +59,12 @@ std::vector<PredictedLight> PredictLights(const DockModel& dock, const PinholeRa
                                           const std::vector<int>& skip_ids,
                                           double margin_px = 2.0, double min_depth_m = 0.05);
 
+// J = d u / d(dtheta, dt) of the dock point p_D's projection at T_C_D, the left perturbation
+// above: d pi / d p_C [-[R p_D]x  I], d pi / d p_C by central differences (the distortion model
+// is the camera's business). Zero where the camera cannot project the point's neighbourhood.
+Eigen::Matrix<double, 2, 6> ProjectionPoseJacobian(const PinholeRadtanCamera& camera,
+                                                   const Pose3& T_C_D, const Eigen::Vector3d& p_D);
+
 // How much larger the identified lights look than the dock's radius_m makes them at T_C_D: the
 // median over the identified detections (light_ids[i] >= 0) of radius_px / predicted radius
 // (the glow, not the emitting disc, sets a light's blob size); 1 with none.

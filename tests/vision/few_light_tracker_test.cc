@@ -1,0 +1,182 @@
+// FewLightTracker and BridgeFramesWithoutPose on a camera moving at a constant rate over the T
+// dock: two of its lights and a speck seen after (or before) a run of posed frames.
+#include "auvdock/vision/few_light_tracker.h"
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "auvdock/geometry/so3.h"
+#include "auvdock/vision/two_way_light_bridge.h"
+#include "tests/testing/dock_views.h"
+
+namespace auvdock {
+namespace {
+
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+
+class FewLightTrackerTest : public ::testing::Test {
+ protected:
+  FewLightTrackerTest()
+      : camera_(test::DefaultMonoCamera()),
+        dock_(test::LoadDock("t_shape.yaml")),
+        start_(test::ViewFromElevation(dock_, 4.0, 60.0 * M_PI / 180.0, 0.0)) {}
+
+  // The camera at frame k: R_k = Exp(k w) R_0, p_k = p_0 + k v (the tracker's own model), plus a
+  // sudden turn of jerk_rad about the camera's y axis (across the T's stem in the image) from
+  // frame jerk_from on.
+  Pose3 Truth(int k, int jerk_from = 1 << 30, double jerk_rad = 0.0) const {
+    const Eigen::Vector3d w(0.002, -0.001, 0.003), v(0.01, 0.004, -0.02);
+    const Eigen::Vector3d jerk(0.0, k >= jerk_from ? jerk_rad : 0.0, 0.0);
+    return Pose3(ExpQuaternion(jerk) * ExpQuaternion(k * w) * start_.q,
+                 start_.p + k * v);
+  }
+
+  Eigen::Vector2d Project(const Pose3& T_C_D, int light_id) const {
+    for (const DockLight& light : dock_.lights) {
+      if (light.id == light_id) return *camera_.Project(T_C_D * light.p_D);
+    }
+    ADD_FAILURE() << "no light " << light_id;
+    return Eigen::Vector2d::Zero();
+  }
+
+  LightDetection Detection(const Eigen::Vector2d& uv) {
+    LightDetection d;
+    d.uv = uv + Eigen::Vector2d(noise_(rng_), noise_(rng_));
+    d.radius_px = 3.0;
+    d.score = 1.0;
+    return d;
+  }
+
+  // Lights 0 and 1 (the T's stem) and a speck 90 px right of and 60 px below light 0.
+  std::vector<LightDetection> TwoLightsAndASpeck(const Pose3& T_C_D) {
+    return {Detection(Project(T_C_D, 0)), Detection(Project(T_C_D, 1)),
+            Detection(Project(T_C_D, 0) + Eigen::Vector2d(90.0, 60.0))};
+  }
+
+  std::vector<LightDetection> AllLights(const Pose3& T_C_D) {
+    std::vector<LightDetection> out;
+    for (const DockLight& light : dock_.lights) out.push_back(Detection(Project(T_C_D, light.id)));
+    return out;
+  }
+
+  // What PnP would give: the truth perturbed by its covariance (1 mrad, 1 cm).
+  Pose3 Measured(const Pose3& truth) {
+    const Eigen::Vector3d dtheta(1e-3 * noise_(rng_), 1e-3 * noise_(rng_), 1e-3 * noise_(rng_));
+    const Eigen::Vector3d dp(1e-2 * noise_(rng_), 1e-2 * noise_(rng_), 1e-2 * noise_(rng_));
+    return Pose3(ExpQuaternion(dtheta) * truth.q, truth.p + dp);
+  }
+
+  static Matrix6 PnpCovariance() {
+    Matrix6 P = Matrix6::Zero();
+    P.diagonal() << 1e-6, 1e-6, 1e-6, 1e-4, 1e-4, 1e-4;
+    return P;
+  }
+
+  bool StartFromPoses(FewLightTracker* tracker, int first, int last) {
+    std::vector<Pose3> poses;
+    std::vector<Matrix6> covariances;
+    for (int k = first; k <= last; ++k) {
+      poses.push_back(Measured(Truth(k)));
+      covariances.push_back(PnpCovariance());
+    }
+    return tracker->Start(poses, covariances);
+  }
+
+  PinholeRadtanCamera camera_;
+  DockModel dock_;
+  Pose3 start_;
+  std::mt19937_64 rng_{7};
+  std::normal_distribution<double> noise_{0.0, 0.3};
+};
+
+TEST_F(FewLightTrackerTest, FollowsTwoLightsForTwentyFramesAndRejectsASpeckFarFromThem) {
+  FewLightTracker tracker(camera_, dock_, 0.1);
+  ASSERT_TRUE(StartFromPoses(&tracker, 0, 5));
+  for (int k = 6; k <= 25; ++k) {
+    const std::optional<FewLightStep> step = tracker.Step(TwoLightsAndASpeck(Truth(k)));
+    ASSERT_TRUE(step) << "frame " << k << ": " << tracker.end_reason();
+    EXPECT_EQ(step->light_ids, (std::vector<int>{0, 1, -1})) << "frame " << k;
+    EXPECT_EQ(step->unexplained, (std::vector<bool>{false, false, true})) << "frame " << k;
+    EXPECT_EQ(step->labelled, 2);
+    // The pose follows the truth along what two lights and the rate tell.
+    EXPECT_LT((step->T_C_D.p - Truth(k).p).norm(), 0.1) << "frame " << k;
+  }
+}
+
+TEST_F(FewLightTrackerTest, NeverGuessesBetweenTwoDetectionsInOneLightsGate) {
+  FewLightTracker tracker(camera_, dock_, 0.1);
+  ASSERT_TRUE(StartFromPoses(&tracker, 0, 5));
+  const Pose3 T = Truth(6);
+  std::vector<LightDetection> detections = {Detection(Project(T, 0)), Detection(Project(T, 1)),
+                                            Detection(Project(T, 0) + Eigen::Vector2d(1.0, 0.5))};
+  const std::optional<FewLightStep> step = tracker.Step(detections);
+  ASSERT_TRUE(step) << tracker.end_reason();
+  EXPECT_EQ(step->light_ids, (std::vector<int>{-1, 1, -1}));
+  // Both stay: each may be light 0.
+  EXPECT_EQ(step->unexplained, (std::vector<bool>{false, false, false}));
+}
+
+TEST_F(FewLightTrackerTest, AJerkTheRateCannotFollowIsNotJudgedAndEndsTheWalk) {
+  FewLightTracker tracker(camera_, dock_, 0.1);
+  ASSERT_TRUE(StartFromPoses(&tracker, 0, 5));
+  for (int k = 6; k < 9; ++k) ASSERT_TRUE(tracker.Step(TwoLightsAndASpeck(Truth(k))));
+  // A 15 degree turn between two frames (the rate model allows about 0.1 rad in a second): every
+  // light moves by a hundred pixels.
+  const int jerk = 9;
+  int judged = 0;
+  for (int k = jerk; k < jerk + 5; ++k) {
+    const std::optional<FewLightStep> step =
+        tracker.Step(TwoLightsAndASpeck(Truth(k, jerk, 15.0 * M_PI / 180.0)));
+    if (!step) break;
+    for (size_t j = 0; j < step->light_ids.size(); ++j) {
+      judged += step->light_ids[j] >= 0 || step->unexplained[j];
+    }
+  }
+  EXPECT_EQ(judged, 0);
+  EXPECT_FALSE(tracker.walking());
+  EXPECT_NE(tracker.end_reason().find("lost"), std::string::npos) << tracker.end_reason();
+}
+
+TEST_F(FewLightTrackerTest, NeedsThreeConsecutivePosesToStart) {
+  FewLightTracker tracker(camera_, dock_, 0.1);
+  EXPECT_FALSE(StartFromPoses(&tracker, 0, 1));
+  EXPECT_FALSE(tracker.Step(TwoLightsAndASpeck(Truth(2))));
+  EXPECT_THROW(FewLightTracker(camera_, dock_, 0.0), std::invalid_argument);
+}
+
+// Frames 0-5 and 11, 13-17 show two lights and a speck; 6-10 all lights with a pose; 12 a lone
+// pose of its own (labels that the walk must leave alone).
+TEST_F(FewLightTrackerTest, TheBridgeWalksBothWaysFromAPosedRunAndThroughALonePose) {
+  std::vector<BridgedFrame> frames(18);
+  for (int k = 0; k < 18; ++k) {
+    const bool posed = (k >= 6 && k <= 10) || k == 12;
+    frames[k].detections = posed ? AllLights(Truth(k)) : TwoLightsAndASpeck(Truth(k));
+    if (posed) {
+      frames[k].T_C_D = Measured(Truth(k));
+      frames[k].covariance_local = PnpCovariance();
+    }
+  }
+  TwoWayLightBridgeOptions options;
+  std::vector<BridgedFrame> both = frames;
+  EXPECT_EQ(BridgeFramesWithoutPose(camera_, dock_, 0.1, options, &both), 12);
+  for (int k = 0; k < 18; ++k) {
+    if (both[k].T_C_D) {
+      EXPECT_FALSE(both[k].bridged) << "frame " << k;
+      continue;
+    }
+    ASSERT_TRUE(both[k].bridged) << "frame " << k;
+    EXPECT_EQ(both[k].anchor_frame, k < 6 ? 6 : 10) << "frame " << k;
+    EXPECT_EQ(both[k].light_ids, (std::vector<int>{0, 1, -1})) << "frame " << k;
+    EXPECT_EQ(both[k].unexplained, (std::vector<bool>{false, false, true})) << "frame " << k;
+  }
+  options.backward = false;
+  std::vector<BridgedFrame> forward = frames;
+  EXPECT_EQ(BridgeFramesWithoutPose(camera_, dock_, 0.1, options, &forward), 6);
+  for (int k = 0; k < 6; ++k) EXPECT_FALSE(forward[k].bridged) << "frame " << k;
+}
+
+}  // namespace
+}  // namespace auvdock
