@@ -10,13 +10,15 @@
 // colour threshold is learned from the identified lights (HaloColourLearner) unless given. The
 // detections that an image's pose leaves unidentified, far from every light it puts in the image
 // (MonoLightPipeline step 6), are reported as rejected candidates ("not a light of the dock at
-// the pose"), not as detections; --keep-unexplained keeps them. At the end of the images, the
-// frames without a pose are bridged from the runs of posed frames before and after them
-// (two_way_light_bridge.h; --bridge forward: from the frames before only, as a live system could;
-// off): the lights such a walk identifies get their ids, and what it finds far from every light
-// is rejected ("not a light of the dock at the neighbouring frames' pose"); their reason in
-// frames.csv says so. Writes, flushed frame by frame (a stopped run keeps every frame written
-// before the stop, unbridged), and written anew from memory after bridging (each file to a
+// the pose"), not as detections; --keep-unexplained keeps them. At the end of the images
+// (two_way_light_bridge.h; --bridge forward: walks forward in time only, as a live system could;
+// off: neither): a tracked chain of poses that a longer chain's walk refutes (it labels more of
+// the frame where they meet) loses its poses ("refuted" in frames.csv), and the frames without a
+// pose are bridged from the chains before and after them: the lights such a walk identifies get
+// their ids, and what it finds far from every light is rejected ("not a light of the dock at the
+// neighbouring frames' pose"); their reason in frames.csv says so. Writes (detect_output.h),
+// flushed frame by frame (a stopped run keeps every frame written before the stop, as it was
+// before the end), and written anew from memory when the end changed anything (each file to a
 // temporary, renamed over the old one; the overlays of the bridged frames are drawn again):
 //   OUTDIR/detections.csv  frame,image,light_id,u,v,radius,score,cov_uu,cov_uv,cov_vv,at_border
 //                          (light_id -1: not identified; covariance in px^2)
@@ -51,6 +53,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "apps/commands.h"
+#include "apps/detect_output.h"
 #include "apps/help_text.h"
 #include "apps/reason_class.h"
 #include "apps/signal_flag.h"
@@ -61,10 +64,8 @@
 #include "auvdock/io/dock_io.h"
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/light_labels_csv.h"
-#include "auvdock/io/pose_covariance_csv.h"
 #include "auvdock/io/staged_directory.h"
 #include "auvdock/vision/mono_light_pipeline.h"
-#include "auvdock/vision/pnp_solver.h"
 #include "auvdock/vision/two_way_light_bridge.h"
 
 namespace fs = std::filesystem;
@@ -92,88 +93,6 @@ struct DetectOptions {
   double label_max_range_m = -1.0;  // < 0: every ok label is required
 };
 
-
-// One image's output, kept for the walks from the posed frames beside it (which may revise its
-// labels at the end of the run).
-struct FrameRecord {
-  int index = 0;
-  std::string path, name;
-  std::vector<LightDetection> detections;
-  std::vector<int> light_ids;  // per detection
-  std::optional<Pose3> T_C_D;
-  Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
-  double residual_sigma_px = 0.0;  // the pose's residual per axis, a posteriori
-  std::string status_columns;  // frames.csv from status to qw
-  std::string symmetry, reason;  // without commas
-  std::vector<RejectedLightCandidate> rejected;  // kept with --overlay only
-};
-
-// detections.csv, frames.csv and (--overlay) rejected.csv: written frame by frame, and written
-// anew (each to a temporary file, then renamed over the old one) when the walks revised labels.
-class FrameOutput {
- public:
-  FrameOutput(const std::string& out, bool overlay) : out_(out), overlay_(overlay) {
-    Open("", &detections_, &frames_, &rejected_);
-  }
-
-  void Write(const FrameRecord& r) { Write(r, &detections_, &frames_, &rejected_); }
-
-  void Rewrite(const std::vector<FrameRecord>& records) {
-    CsvWriter detections, frames, rejected;
-    Open(".tmp", &detections, &frames, &rejected);
-    for (const FrameRecord& r : records) Write(r, &detections, &frames, &rejected);
-    detections.Close();
-    frames.Close();
-    rejected.Close();
-    detections_.Close();
-    frames_.Close();
-    rejected_.Close();
-    for (const char* name : {"/detections.csv", "/frames.csv", "/rejected.csv"}) {
-      if (fs::exists(out_ + name + std::string(".tmp"))) {
-        fs::rename(out_ + name + std::string(".tmp"), out_ + name);
-      }
-    }
-  }
-
- private:
-  void Open(const std::string& suffix, CsvWriter* detections, CsvWriter* frames,
-            CsvWriter* rejected) const {
-    *detections = CsvWriter(out_ + "/detections.csv" + suffix,
-                            "frame,image,light_id,u,v,radius,score,cov_uu,cov_uv,cov_vv,at_border");
-    *frames = CsvWriter(out_ + "/frames.csv" + suffix,
-                        "frame,image,detections,identified,status,tracked,rms_px,sigma_px,tx,ty,"
-                        "tz,qx,qy,qz,qw,symmetry,reason");
-    if (overlay_) {
-      *rejected = CsvWriter(out_ + "/rejected.csv" + suffix, "frame,image,u,v,sigma,reason");
-    }
-  }
-
-  void Write(const FrameRecord& r, CsvWriter* detections, CsvWriter* frames,
-             CsvWriter* rejected) const {
-    const std::string head = std::to_string(r.index) + "," + r.name + ",";
-    int identified = 0;
-    for (size_t i = 0; i < r.detections.size(); ++i) {
-      const LightDetection& d = r.detections[i];
-      identified += r.light_ids[i] >= 0;
-      detections->Line(head + std::to_string(r.light_ids[i]) + "," + FormatDouble(d.uv.x()) + "," +
-                       FormatDouble(d.uv.y()) + "," + FormatDouble(d.radius_px) + "," +
-                       FormatDouble(d.score) + "," + FormatDouble(d.covariance(0, 0)) + "," +
-                       FormatDouble(d.covariance(0, 1)) + "," + FormatDouble(d.covariance(1, 1)) +
-                       "," + (d.at_border ? "1" : "0"));
-    }
-    frames->Line(head + std::to_string(r.detections.size()) + "," + std::to_string(identified) +
-                 "," + r.status_columns + "," + r.symmetry + "," + r.reason);
-    if (!overlay_) return;
-    for (const RejectedLightCandidate& c : r.rejected) {
-      rejected->Line(head + FormatDouble(c.uv.x()) + "," + FormatDouble(c.uv.y()) + "," +
-                     FormatDouble(c.sigma_px) + "," + c.reason);
-    }
-  }
-
-  std::string out_;
-  bool overlay_;
-  CsvWriter detections_, frames_, rejected_;
-};
 
 void DrawOverlay(const cv::Mat& image, const std::vector<LightDetection>& detections,
                  const std::vector<int>& ids, const std::vector<RejectedLightCandidate>& rejected,
@@ -248,17 +167,13 @@ void RunDetect(const DetectOptions& options) {
   RequireAbsentOrEmptyDirectory(options.out);
   fs::create_directories(options.out);
   if (options.overlay) fs::create_directories(options.out + "/overlay");
-  FrameOutput output(options.out, options.overlay);
+  DetectOutput output(options.out, options.overlay);
   std::vector<FrameRecord> records;
-  CsvWriter pose_covariance_csv(options.out + "/camera_pose_covariance.csv",
-                                PoseCovarianceCsvHeader());
-  std::ofstream poses(options.out + "/camera_poses.tum");
-  poses << "# timestamp tx ty tz qx qy qz qw (T_D_C: the camera in the dock frame)\n";
 
   const CancellationToken cancel = InstallSignalCancellation();
   std::map<std::string, int> reasons;
   std::map<std::string, int> rejected_reasons;  // every image's rejected candidates, by kind
-  int n_frames = 0, n_pose = 0, n_tracked = 0, n_no_detection = 0;
+  int n_frames = 0, n_no_detection = 0;
   int n_guided = 0, n_weak_pass = 0;
   double detect_s = 0.0, pose_s = 0.0;
   bool interrupted = false;
@@ -287,12 +202,17 @@ void RunDetect(const DetectOptions& options) {
     const MonoPoseResult& pose = frame.pose;
     FrameRecord record;
     record.index = static_cast<int>(f);
+    record.time_s = f / camera.rate_hz;
     record.path = path;
     record.name = name;
     record.detections = frame.detections;
     record.light_ids = pose.light_ids;
+    record.status = pose.T_C_D ? "ok" : MatchStatusName(pose.status);
+    record.tracked = pose.tracked;
     record.T_C_D = pose.T_C_D;
     record.covariance_local = pose.covariance_local;
+    record.rms_px = pose.rms_px;
+    record.pixel_sigma_px = pose.pixel_sigma_px;
     if (pose.T_C_D && pose.num_lights > 3) {
       record.residual_sigma_px =
           pose.rms_px * std::sqrt(pose.num_lights / (2.0 * pose.num_lights - 6.0));
@@ -309,31 +229,6 @@ void RunDetect(const DetectOptions& options) {
     n_guided += frame.guided_detections;
     n_weak_pass += frame.from_weak_pass;
     if (detections.empty()) ++n_no_detection;
-
-    record.status_columns = std::string(pose.T_C_D ? "ok" : MatchStatusName(pose.status)) + "," +
-                            (pose.tracked ? "1" : "0") + ",";
-    if (pose.T_C_D) {
-      const Pose3& T = *pose.T_C_D;
-      record.status_columns += FormatDouble(pose.rms_px) + "," + FormatDouble(pose.pixel_sigma_px) +
-                               "," + FormatDouble(T.p.x()) + "," + FormatDouble(T.p.y()) + "," +
-                               FormatDouble(T.p.z()) + "," + FormatDouble(T.q.x()) + "," +
-                               FormatDouble(T.q.y()) + "," + FormatDouble(T.q.z()) + "," +
-                               FormatDouble(T.q.w());
-      const Pose3 T_D_C = T.Inverse();
-      char line[256];
-      std::snprintf(line, sizeof(line), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n",
-                    f / camera.rate_hz, T_D_C.p.x(), T_D_C.p.y(), T_D_C.p.z(), T_D_C.q.x(),
-                    T_D_C.q.y(), T_D_C.q.z(), T_D_C.q.w());
-      poses << line << std::flush;
-      pose_covariance_csv.Row(std::llround(1e9 * f / camera.rate_hz),
-                              PoseCovarianceCsvValues(CameraInDockCovariance(
-                                  *pose.T_C_D, pose.covariance_local)));
-      ++n_pose;
-      n_tracked += pose.tracked;
-    } else {
-      record.status_columns += ",,,,,,,,";
-      ++reasons[ReasonClass(pose.reason)];
-    }
     // Why the detector found too few lights: its rejected candidates, by kind (a wrong colour
     // setting shows here as "wrong colour" in every image).
     std::map<std::string, int> rejected_here;
@@ -343,6 +238,7 @@ void RunDetect(const DetectOptions& options) {
       ++rejected_reasons[kind];
     }
     record.reason = pose.reason;
+    if (!pose.T_C_D) ++reasons[ReasonClass(pose.reason)];
     if (!pose.T_C_D && !rejected_here.empty() &&
         static_cast<int>(detections.size()) < pipeline_options.poser.min_lights) {
       const auto most = std::max_element(
@@ -369,7 +265,7 @@ void RunDetect(const DetectOptions& options) {
 
   // The frames without a pose, from the posed frames beside them (two_way_light_bridge.h); the
   // files written frame by frame are then written anew with what the walks identified.
-  int n_bridged = 0, n_bridge_identified = 0, n_bridge_unexplained = 0;
+  int n_bridged = 0, n_bridge_identified = 0, n_bridge_unexplained = 0, n_refuted = 0;
   if (!interrupted && options.bridge != "off" && !options.no_tracking) {
     std::vector<BridgedFrame> frames(records.size());
     for (size_t k = 0; k < records.size(); ++k) {
@@ -377,6 +273,8 @@ void RunDetect(const DetectOptions& options) {
       frames[k].T_C_D = records[k].T_C_D;
       frames[k].covariance_local = records[k].covariance_local;
       frames[k].residual_sigma_px = records[k].residual_sigma_px;
+      frames[k].tracked = records[k].tracked;
+      for (const int id : records[k].light_ids) frames[k].identified += id >= 0;
     }
     TwoWayLightBridgeOptions bridge_options;
     bridge_options.backward = options.bridge == "both";
@@ -384,8 +282,19 @@ void RunDetect(const DetectOptions& options) {
     n_bridged = BridgeFramesWithoutPose(camera.intrinsics, dock, 1.0 / camera.rate_hz,
                                         bridge_options, &frames);
     for (size_t k = 0; k < records.size(); ++k) {
-      if (!frames[k].bridged) continue;
       FrameRecord& record = records[k];
+      if (frames[k].refuted) {
+        ++n_refuted;
+        const int by = records[frames[k].refuted_by].index;
+        record.reason = "refuted: its tracked pose (" + std::to_string(frames[k].identified) +
+                        " lights) is refuted by the longer run of poses from frame " +
+                        std::to_string(by) + ", whose walk labels more of its detections";
+        record.status = "refuted";
+        record.tracked = false;
+        record.T_C_D.reset();
+        record.light_ids.assign(record.detections.size(), -1);
+      }
+      if (!frames[k].bridged) continue;
       std::vector<LightDetection> kept;
       std::vector<int> ids;
       std::vector<RejectedLightCandidate> unexplained;
@@ -403,7 +312,7 @@ void RunDetect(const DetectOptions& options) {
       n_bridge_identified += identified;
       n_bridge_unexplained += static_cast<int>(unexplained.size());
       const int anchor_frame = records[frames[k].anchor_frame].index;
-      record.reason += "; " + std::to_string(identified) + " identified and " +
+      record.reason += (record.reason.empty() ? "" : "; ") + std::to_string(identified) + " identified and " +
                        std::to_string(unexplained.size()) +
                        " unexplained by the poses of the frames from " +
                        std::to_string(anchor_frame) + (anchor_frame > record.index ? " back" : " on");
@@ -421,7 +330,13 @@ void RunDetect(const DetectOptions& options) {
         }
       }
     }
-    if (n_bridged > 0) output.Rewrite(records);
+    if (n_bridged > 0 || n_refuted > 0) output.Rewrite(records);
+  }
+  int n_pose = 0, n_tracked = 0;
+  for (const FrameRecord& record : records) {
+    n_pose += record.T_C_D.has_value();
+    n_tracked += record.T_C_D && record.tracked;
+    if (record.status == "refuted") ++reasons["refuted by a longer run of poses"];
   }
   int n_detections = 0;
   std::map<std::string, FrameDetections> evaluated;
@@ -440,6 +355,7 @@ void RunDetect(const DetectOptions& options) {
   summary["frames_tracked"] = n_tracked;
   summary["frames_without_detection"] = n_no_detection;
   summary["detections"] = n_detections;
+  summary["frames_refuted"] = n_refuted;
   summary["bridged_frames"] = {{"frames", n_bridged},
                                {"identified", n_bridge_identified},
                                {"unexplained", n_bridge_unexplained}};
@@ -457,6 +373,9 @@ void RunDetect(const DetectOptions& options) {
               options.out.c_str(), n_pose, n_tracked, n_detections);
   for (const auto& [reason, count] : reasons) {
     std::printf("  no pose: %d x %s\n", count, reason.c_str());
+  }
+  if (n_refuted > 0) {
+    std::printf("  %d tracked poses refuted by a longer run of poses (withdrawn)\n", n_refuted);
   }
   if (n_bridged > 0) {
     std::printf("  %d frames without a pose bridged by their neighbours' poses: %d lights "

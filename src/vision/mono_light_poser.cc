@@ -93,7 +93,7 @@ MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detectio
                     ")";
     return result;
   }
-  if (!result.tracked) {
+  const auto from_scratch_match = [&]() {
     RansacMatcherOptions ransac = options_.ransac;
     ransac.pixel_noise_px = sigma;
     ransac.final_gate_px = std::max(ransac.final_gate_px, 6.0 * sigma);
@@ -102,12 +102,31 @@ MonoPoseResult MonoLightPoser::Solve(const std::vector<LightDetection>& detectio
     SymmetryHint hint;
     if (last_T_C_D_) hint.predicted_T_C_D = last_T_C_D_;
     hint.gravity_C = options_.gravity_C;
-    const RansacMatchResult r =
-        MatchRansac(detections, dock_, camera_.intrinsics, ransac, rng_, hint);
+    return MatchRansac(detections, dock_, camera_.intrinsics, ransac, rng_, hint);
+  };
+  if (!result.tracked) {
+    const RansacMatchResult r = from_scratch_match();
     match = r;
     start = r.T_C_D;
     result.symmetric_T_C_D = r.symmetric_T_C_D;
     result.symmetry_note = r.symmetry;
+  } else if (from_scratch && options_.recheck_unexplained_detections > 0 &&
+             static_cast<int>(detections.size()) >= options_.min_lights &&
+             detections.size() >= match.matches.size() +
+                                      static_cast<size_t>(options_.recheck_unexplained_detections)) {
+    // Tracking can carry a wrong labelling (a few lights and clutter that fit it) while the true
+    // lights stay unexplained beside it; identification from scratch that explains decisively
+    // more of the frame replaces it.
+    const RansacMatchResult r = from_scratch_match();
+    if (r.status == MatchStatus::kOk &&
+        r.matches.size() >=
+            match.matches.size() + static_cast<size_t>(options_.recheck_unexplained_detections)) {
+      match = r;
+      start = r.T_C_D;
+      result.tracked = false;
+      result.symmetric_T_C_D = r.symmetric_T_C_D;
+      result.symmetry_note = r.symmetry;
+    }
   }
   result.status = match.status;
   if (match.status != MatchStatus::kOk) {

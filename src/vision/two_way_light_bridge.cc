@@ -2,45 +2,129 @@
 
 #include <algorithm>
 #include <cstdlib>
-#include <utility>
+#include <numeric>
 
 namespace auvdock {
 namespace {
 
-// Walks from the posed frames [first, last] (in walking order: step = +1 forward from last,
-// -1 backward from first) until the next run of posed frames that a walk could start from
-// (anchor), through the frames of shorter runs, whose own labels stay, and records each reached
-// frame without a pose when it is nearer to its anchor than what another walk recorded there
-// (distance[k]).
-void Walk(FewLightTracker* tracker, int first, int last, int step, const std::vector<bool>& anchor,
-          std::vector<BridgedFrame>* frames, std::vector<int>* distance) {
-  std::vector<Pose3> poses;
-  std::vector<FewLightTracker::Matrix6> covariances;
-  std::vector<double> sigmas;
-  const int from = step > 0 ? first : last, to = step > 0 ? last : first;
-  for (int k = from;; k += step) {
-    poses.push_back(*(*frames)[k].T_C_D);
-    covariances.push_back((*frames)[k].covariance_local);
-    sigmas.push_back((*frames)[k].residual_sigma_px);
-    if (k == to) break;
+// A tracking chain: posed frames each tracked from the one before (frames without a pose may lie
+// between them); one labelling hypothesis carried along.
+struct Chain {
+  std::vector<int> frames;  // posed, in time order
+  bool refuted = false;
+  int refuted_by = -1;
+};
+
+class Bridge {
+ public:
+  Bridge(FewLightTracker* tracker, const TwoWayLightBridgeOptions& options,
+         std::vector<BridgedFrame>* frames)
+      : tracker_(tracker), options_(options), frames_(*frames) {
+    const int n = static_cast<int>(frames_.size());
+    chain_of_.assign(n, -1);
+    distance_.assign(n, n + 1);
+    for (int k = 0; k < n; ++k) {
+      if (!frames_[k].T_C_D) continue;
+      if (!frames_[k].tracked || chains_.empty()) chains_.emplace_back();
+      chains_.back().frames.push_back(k);
+      chain_of_[k] = static_cast<int>(chains_.size()) - 1;
+    }
   }
-  std::nth_element(sigmas.begin(), sigmas.begin() + sigmas.size() / 2, sigmas.end());
-  if (!tracker->Start(poses, covariances, sigmas[sigmas.size() / 2])) return;
-  const int n = static_cast<int>(frames->size());
-  for (int k = to + step; k >= 0 && k < n && !anchor[k]; k += step) {
-    BridgedFrame& frame = (*frames)[k];
-    const std::optional<FewLightStep> result = tracker->Step(frame.detections);
-    if (!result) return;
-    if (frame.T_C_D) continue;
-    const int walked = std::abs(k - to);
-    if (walked >= (*distance)[k]) continue;
-    (*distance)[k] = walked;
-    frame.bridged = true;
-    frame.anchor_frame = to;
-    frame.light_ids = result->light_ids;
-    frame.unexplained = result->unexplained;
+
+  // Pass 1: the longest chains first walk into their neighbours and refute a chain whose own
+  // labels explain decisively fewer detections than the walk labels in the frame where they meet.
+  void Refute() {
+    std::vector<int> order(chains_.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+      return chains_[a].frames.size() > chains_[b].frames.size();
+    });
+    for (int c : order) {
+      if (chains_[c].refuted) continue;
+      Walk(c, +1, /*record=*/false);
+      if (options_.backward) Walk(c, -1, /*record=*/false);
+    }
   }
-}
+
+  // Pass 2: every chain that stands walks into the frames without a pose beside it (and through
+  // the refuted chains), recording the labels.
+  void Record() {
+    for (size_t c = 0; c < chains_.size(); ++c) {
+      if (chains_[c].refuted) continue;
+      Walk(static_cast<int>(c), +1, /*record=*/true);
+      if (options_.backward) Walk(static_cast<int>(c), -1, /*record=*/true);
+    }
+    for (const Chain& chain : chains_) {
+      if (!chain.refuted) continue;
+      for (int k : chain.frames) {
+        frames_[k].refuted = true;
+        frames_[k].refuted_by = chain.refuted_by;
+      }
+    }
+  }
+
+ private:
+  bool Stands(int k) const { return chain_of_[k] >= 0 && !chains_[chain_of_[k]].refuted; }
+
+  // Walks from chain c's end (step +1: forward from its last frame; -1: backward from its first)
+  // while frames without a standing pose follow; a chain too short to start a walk is walked
+  // through (its own labels stay unless refuted).
+  void Walk(int c, int step, bool record) {
+    const std::vector<int>& own = chains_[c].frames;
+    // The consecutive posed frames at that end, in walking order.
+    std::vector<int> start;
+    const int end = step > 0 ? own.back() : own.front();
+    for (int k = end; k >= 0 && k < static_cast<int>(frames_.size()) && chain_of_[k] == c;
+         k -= step) {
+      start.insert(start.begin(), k);
+    }
+    std::vector<Pose3> poses;
+    std::vector<FewLightTracker::Matrix6> covariances;
+    std::vector<double> sigmas;
+    for (int k : start) {
+      poses.push_back(*frames_[k].T_C_D);
+      covariances.push_back(frames_[k].covariance_local);
+      sigmas.push_back(frames_[k].residual_sigma_px);
+    }
+    std::nth_element(sigmas.begin(), sigmas.begin() + sigmas.size() / 2, sigmas.end());
+    if (!tracker_->Start(poses, covariances, sigmas[sigmas.size() / 2])) return;
+    const int n = static_cast<int>(frames_.size());
+    for (int k = end + step; k >= 0 && k < n; k += step) {
+      const int other = chain_of_[k];
+      if (other == c) return;
+      BridgedFrame& frame = frames_[k];
+      const std::optional<FewLightStep> result = tracker_->Step(frame.detections);
+      if (!result) return;
+      if (Stands(k)) {
+        Chain& chain = chains_[other];
+        const bool decisive = result->labelled >= frame.identified + options_.refute_margin;
+        if (!record && decisive && own.size() > chain.frames.size()) {
+          chain.refuted = true;
+          chain.refuted_by = end;
+        } else if (static_cast<int>(chain.frames.size()) < options_.tracker.min_start_poses) {
+          continue;  // a lone pose among frames without one: walked through
+        } else {
+          return;
+        }
+      }
+      if (!record) continue;
+      const int walked = std::abs(k - end);
+      if (walked >= distance_[k]) continue;
+      distance_[k] = walked;
+      frame.bridged = true;
+      frame.anchor_frame = end;
+      frame.light_ids = result->light_ids;
+      frame.unexplained = result->unexplained;
+    }
+  }
+
+  FewLightTracker* tracker_;
+  const TwoWayLightBridgeOptions& options_;
+  std::vector<BridgedFrame>& frames_;
+  std::vector<Chain> chains_;
+  std::vector<int> chain_of_;
+  std::vector<int> distance_;
+};
 
 }  // namespace
 
@@ -48,27 +132,9 @@ int BridgeFramesWithoutPose(const PinholeRadtanCamera& camera, const DockModel& 
                             double frame_interval_s, const TwoWayLightBridgeOptions& options,
                             std::vector<BridgedFrame>* frames) {
   FewLightTracker tracker(camera, dock, frame_interval_s, options.tracker);
-  const int n = static_cast<int>(frames->size());
-  std::vector<int> distance(n, n + 1);
-  std::vector<std::pair<int, int>> runs;  // [first, last] of the posed runs a walk starts from
-  std::vector<bool> anchor(n, false);
-  for (int k = 0; k < n;) {
-    if (!(*frames)[k].T_C_D) {
-      ++k;
-      continue;
-    }
-    int end = k;
-    while (end + 1 < n && (*frames)[end + 1].T_C_D) ++end;
-    if (end - k + 1 >= options.tracker.min_start_poses) {
-      runs.emplace_back(k, end);
-      std::fill(anchor.begin() + k, anchor.begin() + end + 1, true);
-    }
-    k = end + 1;
-  }
-  for (const auto& [first, last] : runs) {
-    Walk(&tracker, first, last, +1, anchor, frames, &distance);
-    if (options.backward) Walk(&tracker, first, last, -1, anchor, frames, &distance);
-  }
+  Bridge bridge(&tracker, options, frames);
+  if (options.refute_margin > 0) bridge.Refute();
+  bridge.Record();
   int bridged = 0;
   for (const BridgedFrame& f : *frames) bridged += f.bridged;
   return bridged;

@@ -157,6 +157,8 @@ TEST_F(FewLightTrackerTest, TheBridgeWalksBothWaysFromAPosedRunAndThroughALonePo
     if (posed) {
       frames[k].T_C_D = Measured(Truth(k));
       frames[k].covariance_local = PnpCovariance();
+      frames[k].tracked = k >= 7 && k <= 10;  // 6 and the lone 12 from scratch
+      frames[k].identified = static_cast<int>(frames[k].detections.size());
     }
   }
   TwoWayLightBridgeOptions options;
@@ -176,6 +178,55 @@ TEST_F(FewLightTrackerTest, TheBridgeWalksBothWaysFromAPosedRunAndThroughALonePo
   std::vector<BridgedFrame> forward = frames;
   EXPECT_EQ(BridgeFramesWithoutPose(camera_, dock_, 0.1, options, &forward), 6);
   for (int k = 0; k < 6; ++k) EXPECT_FALSE(forward[k].bridged) << "frame " << k;
+}
+
+// A chain of 20 true poses (frames 10-29) after a chain of 6 tracked poses (4-9) whose labels
+// take one light and three specks for the dock, 1 m off, while the five other lights stay
+// unexplained beside them (as tracking carried one in the renders): walking back from the longer chain labels more of frame 9 than its own pose did,
+// so the short chain is refuted, its poses withdrawn, and its frames bridged with the true labels.
+TEST_F(FewLightTrackerTest, ALongerChainRefutesAWrongTrackedChainBesideIt) {
+  std::vector<BridgedFrame> frames(30);
+  for (int k = 4; k < 30; ++k) {
+    BridgedFrame& f = frames[k];
+    if (k >= 10) {
+      f.detections = AllLights(Truth(k));
+      f.identified = static_cast<int>(f.detections.size());
+      f.T_C_D = Measured(Truth(k));
+    } else {
+      // Every light and three specks; the wrong pose "identifies" light 4 and the specks.
+      f.detections = AllLights(Truth(k));
+      for (const Eigen::Vector2d& corner : {Eigen::Vector2d(40.0, 40.0),
+                                           Eigen::Vector2d(600.0, 40.0),
+                                           Eigen::Vector2d(40.0, 470.0)}) {
+        f.detections.push_back(Detection(corner));
+      }
+      f.identified = 4;
+      f.T_C_D = Pose3(Truth(k).q, Truth(k).p + Eigen::Vector3d(1.0, 0.0, 0.0));
+    }
+    f.covariance_local = PnpCovariance();
+    f.tracked = k != 4 && k != 10;
+  }
+  TwoWayLightBridgeOptions options;
+  std::vector<BridgedFrame> refuted = frames;
+  BridgeFramesWithoutPose(camera_, dock_, 0.1, options, &refuted);
+  for (int k = 4; k < 10; ++k) {
+    EXPECT_TRUE(refuted[k].refuted) << "frame " << k;
+    EXPECT_EQ(refuted[k].refuted_by, 10) << "frame " << k;
+    ASSERT_TRUE(refuted[k].bridged) << "frame " << k;
+    EXPECT_EQ(refuted[k].light_ids, (std::vector<int>{0, 1, 2, 3, 4, 5, -1, -1, -1}))
+        << "frame " << k;
+  }
+  for (int k = 10; k < 30; ++k) EXPECT_FALSE(refuted[k].refuted) << "frame " << k;
+
+  // Where the walk labels fewer more than the margin asks (6 against 4 + 3), the wrong chain
+  // stands and nothing is bridged across it.
+  options.refute_margin = 3;
+  std::vector<BridgedFrame> standing = frames;
+  BridgeFramesWithoutPose(camera_, dock_, 0.1, options, &standing);
+  for (int k = 4; k < 10; ++k) {
+    EXPECT_FALSE(standing[k].refuted) << "frame " << k;
+    EXPECT_FALSE(standing[k].bridged) << "frame " << k;
+  }
 }
 
 }  // namespace

@@ -4,7 +4,9 @@
 // Per frame: with a pose from the previous frame (at most max_gap_frames old), the detections
 // are labelled by prediction (MatchByPrediction, tracking_gate_px: the motion between frames);
 // otherwise, or if that fails, from scratch (MatchRansac). Tracking needs min_tracked_lights, from
-// scratch min_lights. The labelled lights then give the pose
+// scratch min_lights. A tracked labelling that leaves recheck_unexplained_detections or more
+// detections unexplained is identified from scratch as well, and replaced when that explains as
+// many more. The labelled lights then give the pose
 // by PnP (SolvePnp, started at the matcher's pose) with the pixel noise
 //   sigma = max(camera pixel_noise_px, sqrt(mean over the used detections of trace(C_i) / 2)),
 // C_i a detection's own centroid covariance (zero: not measured), so that PnP's covariance and
@@ -51,6 +53,11 @@ struct MonoLightPoserOptions {
   // 0.940), so by default tracking needs min_lights too.
   int min_tracked_lights = 4;
   bool use_tracking = true;
+  // A tracked labelling that leaves this many detections or more unexplained is checked by
+  // identification from scratch, which replaces it when it explains this many more (0: never).
+  // Tracking can carry a wrong labelling of one light and a few fittings for tens of frames
+  // while the true lights stay unexplained beside it (randomised renders, seed 4, cam2).
+  int recheck_unexplained_detections = 2;
   // Gravity's direction in the camera frame when the camera's attitude is roughly known (a
   // camera held upright: (0, 1, 0)), to choose among a symmetric dock's poses (SymmetryHint).
   std::optional<Eigen::Vector3d> gravity_C;

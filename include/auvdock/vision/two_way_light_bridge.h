@@ -1,13 +1,27 @@
 // The lights of a camera's frames without a pose, identified from the posed frames beside them
-// (FewLightTracker): from every run of at least min_start_poses consecutive posed frames, a walk
-// forward in time into the frames after it and, on recorded footage, a walk backward into the
-// frames before it, each until the next such run or until the walk ends. A shorter run of posed
-// frames is walked through (its own labels stay): a single pose among frames without one is as
-// likely a wrong one (a symmetric-looking part of the layout among fittings). A frame reached by
-// two walks takes the labels of the one whose posed frames are nearer (fewer frames walked). The
-// dock entering the downward camera's view shows 1-3 lights among the deck's fittings for tens of
-// frames before a pose of its own is possible; the poses that follow identify them, and what
-// they leave far from every light is no light of the dock.
+// (FewLightTracker), and tracked poses that the longer record around them refutes.
+//
+// Chains: a posed frame that was tracked from the pose before it (MonoPoseResult::tracked)
+// continues that pose's chain; one from scratch starts a new one. A chain is one labelling
+// hypothesis carried along, right or wrong as a whole.
+//
+// 1. Refutation (refute_margin > 0), longest chains first: a walk from a chain's first and last
+//    consecutive poses (min_start_poses of them at least) into the frames beside it meets the
+//    next chain; when, in the frame where they meet, the walk labels at least refute_margin
+//    detections more than that frame's own pose identified (and passes its consistency test
+//    there), and the walking chain holds more posed frames, the met chain is refuted: all its poses are withdrawn and the walk goes on through
+//    it. Tracking can carry one light and a few fittings that fit the dock for tens of frames
+//    (randomised renders, seed 4, cam2: 31 frames, 2 m off) until a pose from scratch on the
+//    true lights takes over; walking back from that longer chain finds the true lights
+//    unexplained beside the wrong labels.
+// 2. Bridging: from every chain that stands, a walk forward in time into the frames after it
+//    and, on recorded footage (backward), one backward into the frames before it, each until a
+//    standing chain's pose (a chain too short to start a walk is walked through; its own labels
+//    stay) or until the walk ends. A frame reached by two walks takes the labels of the one whose
+//    posed frames are nearer (fewer frames walked).
+// The dock entering the downward camera's view shows 1-3 lights among the deck's fittings for
+// tens of frames before a pose of its own is possible; the poses that follow identify them, and
+// what they leave far from every light is no light of the dock.
 //
 // Units and frames: FewLightTracker's.
 #pragma once
@@ -31,10 +45,15 @@ struct BridgedFrame {
   std::vector<LightDetection> detections;
   std::optional<Pose3> T_C_D;
   Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
+  bool tracked = false;  // the pose was tracked from the pose before it
+  int identified = 0;    // detections its own pose labelled
   // The pose's residual per axis, a posteriori: rms_px sqrt(n / (2 n - 6)) for n lights (0:
   // unknown); a walk's detections are judged with the median of its start poses' at least.
   double residual_sigma_px = 0.0;
-  // Out, for a frame without a pose that a walk reached (bridged):
+  // Out: a frame whose pose a longer chain refuted (its pose is to be withdrawn) ...
+  bool refuted = false;
+  int refuted_by = -1;  // the first or last frame of the chain whose walk refuted it
+  // ... or without a pose, that a walk reached (bridged; a refuted frame may be bridged too):
   bool bridged = false;
   int anchor_frame = -1;           // the posed frame the walk started next to
   std::vector<int> light_ids;       // per detection: dock light id or -1
@@ -44,6 +63,7 @@ struct BridgedFrame {
 struct TwoWayLightBridgeOptions {
   FewLightTrackerOptions tracker;
   bool backward = true;  // false: forward in time only (what a live system could do)
+  int refute_margin = 1;  // 0: no refutation
 };
 
 // Fills the out fields of frames (in time order). Returns the number of frames bridged.
