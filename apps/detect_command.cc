@@ -118,6 +118,62 @@ void DrawOverlay(const cv::Mat& image, const std::vector<LightDetection>& detect
   cv::imwrite(path, vis);
 }
 
+struct WalkRevision {
+  int refuted = 0, identified = 0, unexplained = 0;
+};
+
+// The records revised by the walks of the end (two_way_light_bridge.h): a refuted frame loses
+// its pose and identities; a bridged one gets the walk's identities, and what the walk judged no
+// light of the dock moves to its rejected candidates (unless keep_unexplained). Each says so in
+// its reason.
+WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep_unexplained,
+                              std::vector<FrameRecord>* records,
+                              std::map<std::string, int>* rejected_reasons) {
+  const std::string not_a_light = "not a light of the dock at the neighbouring frames' pose";
+  WalkRevision revision;
+  for (size_t k = 0; k < records->size(); ++k) {
+    FrameRecord& record = (*records)[k];
+    const BridgedFrame& walked = frames[k];
+    if (walked.refuted) {
+      ++revision.refuted;
+      record.reason = "refuted: its tracked pose (" + std::to_string(walked.identified) +
+                      " lights) is refuted by the longer run of poses from frame " +
+                      std::to_string((*records)[walked.refuted_by].index) +
+                      ", whose walk labels more of its detections";
+      record.status = "refuted";
+      record.tracked = false;
+      record.T_C_D.reset();
+      record.light_ids.assign(record.detections.size(), -1);
+    }
+    if (!walked.bridged) continue;
+    std::vector<LightDetection> kept;
+    std::vector<int> ids;
+    int identified = 0, unexplained = 0;
+    for (size_t i = 0; i < record.detections.size(); ++i) {
+      const LightDetection& d = record.detections[i];
+      if (walked.unexplained[i] && !keep_unexplained) {
+        ++unexplained;
+        ++(*rejected_reasons)[not_a_light];
+        record.rejected.push_back({d.uv, d.radius_px, not_a_light});
+        continue;
+      }
+      kept.push_back(d);
+      ids.push_back(walked.light_ids[i]);
+      identified += ids.back() >= 0;
+    }
+    revision.identified += identified;
+    revision.unexplained += unexplained;
+    const int anchor = (*records)[walked.anchor_frame].index;
+    record.reason += (record.reason.empty() ? "" : "; ") + std::to_string(identified) +
+                     " identified and " + std::to_string(unexplained) +
+                     " unexplained by the poses of the frames from " + std::to_string(anchor) +
+                     (anchor > record.index ? " back" : " on");
+    record.detections = std::move(kept);
+    record.light_ids = std::move(ids);
+  }
+  return revision;
+}
+
 void RunDetect(const DetectOptions& options) {
   std::vector<cv::String> files;
   try {
@@ -281,53 +337,19 @@ void RunDetect(const DetectOptions& options) {
     bridge_options.tracker.pixel_noise_px = camera.pixel_noise_px;
     n_bridged = BridgeFramesWithoutPose(camera.intrinsics, dock, 1.0 / camera.rate_hz,
                                         bridge_options, &frames);
-    for (size_t k = 0; k < records.size(); ++k) {
-      FrameRecord& record = records[k];
-      if (frames[k].refuted) {
-        ++n_refuted;
-        const int by = records[frames[k].refuted_by].index;
-        record.reason = "refuted: its tracked pose (" + std::to_string(frames[k].identified) +
-                        " lights) is refuted by the longer run of poses from frame " +
-                        std::to_string(by) + ", whose walk labels more of its detections";
-        record.status = "refuted";
-        record.tracked = false;
-        record.T_C_D.reset();
-        record.light_ids.assign(record.detections.size(), -1);
-      }
-      if (!frames[k].bridged) continue;
-      std::vector<LightDetection> kept;
-      std::vector<int> ids;
-      std::vector<RejectedLightCandidate> unexplained;
-      int identified = 0;
-      for (size_t i = 0; i < record.detections.size(); ++i) {
-        if (frames[k].unexplained[i] && !options.keep_unexplained) {
-          unexplained.push_back({record.detections[i].uv, record.detections[i].radius_px,
-                                 "not a light of the dock at the neighbouring frames' pose"});
-          continue;
-        }
-        kept.push_back(record.detections[i]);
-        ids.push_back(frames[k].light_ids[i]);
-        identified += ids.back() >= 0;
-      }
-      n_bridge_identified += identified;
-      n_bridge_unexplained += static_cast<int>(unexplained.size());
-      const int anchor_frame = records[frames[k].anchor_frame].index;
-      record.reason += (record.reason.empty() ? "" : "; ") + std::to_string(identified) + " identified and " +
-                       std::to_string(unexplained.size()) +
-                       " unexplained by the poses of the frames from " +
-                       std::to_string(anchor_frame) + (anchor_frame > record.index ? " back" : " on");
-      record.detections = std::move(kept);
-      record.light_ids = std::move(ids);
-      for (const RejectedLightCandidate& r : unexplained) {
-        ++rejected_reasons["not a light of the dock at the neighbouring frames' pose"];
-        if (options.overlay) record.rejected.push_back(r);
-      }
-      if (options.overlay && (!unexplained.empty() || identified > 0)) {
-        const cv::Mat image = cv::imread(record.path, cv::IMREAD_UNCHANGED);
-        if (!image.empty()) {
-          DrawOverlay(image, record.detections, record.light_ids, record.rejected,
-                      options.out + "/overlay/" + fs::path(record.name).stem().string() + ".png");
-        }
+    const WalkRevision revision =
+        ReviseByTheWalks(frames, options.keep_unexplained, &records, &rejected_reasons);
+    n_refuted = revision.refuted;
+    n_bridge_identified = revision.identified;
+    n_bridge_unexplained = revision.unexplained;
+    if (options.overlay) {
+      for (size_t k = 0; k < records.size(); ++k) {
+        if (!frames[k].refuted && !frames[k].bridged) continue;
+        const cv::Mat image = cv::imread(records[k].path, cv::IMREAD_UNCHANGED);
+        if (image.empty()) continue;
+        DrawOverlay(image, records[k].detections, records[k].light_ids, records[k].rejected,
+                    options.out + "/overlay/" + fs::path(records[k].name).stem().string() +
+                        ".png");
       }
     }
     if (n_bridged > 0 || n_refuted > 0) output.Rewrite(records);

@@ -12,7 +12,8 @@ is T_D_B at the image's time stamp (its file name, nanoseconds) composed with T_
 
 Prints one line of JSON: poses, median position and rotation errors (mm, deg), mean NEES
 (6 dof: 6 when the covariance is right), and the share of poses above the 97.5 % point of
-chi-square(6) (14.45; 2.5 % when right). Needs python3-numpy (Debian: call /usr/bin/python3).
+chi-square(6) (14.45; 2.5 % when right), and poses_off: how many are off by more than 0.3 m or
+5 deg (a wrong labelling, not noise). Needs python3-numpy (Debian: call /usr/bin/python3).
 """
 import argparse
 import csv
@@ -121,6 +122,9 @@ def main():
             "mean_nees": float(np.mean(nees)),
             "median_nees": float(np.median(nees)),
             "share_above_chi2_975": float(np.mean(np.array(nees) > CHI2_6_975)),
+            # Wrong poses: off by more than 0.3 m or 5 deg (a wrong labelling, not noise).
+            "poses_off": int(np.sum((np.array(position_mm) > 300.0) |
+                                    (np.array(rotation_deg) > 5.0))),
         })
     print(json.dumps(result))
 

@@ -58,7 +58,7 @@ print(f"detector on renders ({out}), lights nearer than {max_range} m required")
 print(f"{'seed':>5} {'camera':>7} {'recall':>8} {'precision':>10} {'rms [px]':>9} "
       f"{'median':>7} {'pose':>11} {'ms/frame':>9} {'pose mm':>8} {'NEES':>7} {'>97.5%':>7}")
 total = dict(ok=0, hits=0, det=0, true=0, sq=0.0, n=0, pose=0, eligible=0, nees=0.0, above=0.0,
-             posed=0)
+             posed=0, off=0)
 for seed in seeds:
     for camera in cameras:
         with open(f"{out}/seed_{seed}/{camera}/summary.json") as f:
@@ -78,6 +78,7 @@ for seed in seeds:
             total["posed"] += p["poses"]
             total["nees"] += p["mean_nees"] * p["poses"]
             total["above"] += p["share_above_chi2_975"] * p["poses"]
+            total["off"] += p.get("poses_off", 0)
         total["ok"] += e["ok_labels"]; total["hits"] += hits
         total["det"] += e["detections"]; total["true"] += true
         total["sq"] += e["centroid_rms_px"] ** 2 * e["centroid_samples"]
@@ -90,6 +91,7 @@ posed = max(1, total["posed"])
 print(f"{'all':>5} {'':>7} {recall:8.3f} {precision:10.3f} {rms:9.3f} {'':>7} "
       f"{total['pose']:>5}/{total['eligible']:<5} {'':>9} {'':>8} {total['nees'] / posed:7.2f} "
       f"{total['above'] / posed:7.3f}")
+print(f"mono poses: {total['posed']}, of which {total['off']} off by more than 0.3 m or 5 deg")
 print("pose mm: median position error of the mono poses against the truth; NEES: their mean "
       "NEES in detect's covariance (6 when honest); >97.5%: the share above chi-square(6)'s "
       "97.5 % point (0.025 when honest)")

@@ -102,6 +102,36 @@ std::vector<std::string> DetectArgs(const Footage& footage, const std::string& o
           "--labels", footage.dir / "labels.csv", "--overlay", "--quiet"};
 }
 
+// Every detection in out/detections.csv is a true light of the footage (within 1 px) with an id,
+// and each true light keeps one id throughout (which one is defined up to the dock's symmetry);
+// lights: how many true lights are seen.
+void ExpectEveryDetectionIdentifiedConsistently(const Footage& footage, const std::string& out,
+                                                size_t lights) {
+  std::map<int, int> reported_of_true;
+  std::ifstream detections(out + "/detections.csv");
+  std::string line;
+  std::getline(detections, line);
+  while (std::getline(detections, line)) {
+    std::stringstream s(line);
+    std::string frame, image, id, u, v;
+    std::getline(s, frame, ',');
+    std::getline(s, image, ',');
+    std::getline(s, id, ',');
+    std::getline(s, u, ',');
+    std::getline(s, v, ',');
+    const Eigen::Vector2d uv(std::stod(u), std::stod(v));
+    int truth = -1;
+    for (const auto& [true_id, p] : footage.truth[std::stoi(frame)]) {
+      if ((p - uv).norm() < 1.0) truth = true_id;
+    }
+    ASSERT_GE(truth, 0) << line;
+    ASSERT_GE(std::stoi(id), 0) << line;
+    const auto [it, inserted] = reported_of_true.emplace(truth, std::stoi(id));
+    EXPECT_EQ(it->second, std::stoi(id)) << "light " << truth << " changed identity: " << line;
+  }
+  EXPECT_EQ(reported_of_true.size(), lights);
+}
+
 TEST(DetectCli, PosesEveryFrameOfASymmetricRingWithConsistentIdentities) {
   Footage footage;
   std::filesystem::create_directories(footage.dir / "frames");
@@ -137,28 +167,7 @@ TEST(DetectCli, PosesEveryFrameOfASymmetricRingWithConsistentIdentities) {
   std::getline(frames, line);
   EXPECT_NE(line.find("4-fold"), std::string::npos) << line;
   EXPECT_NE(line.find("unresolved"), std::string::npos) << line;
-  std::map<int, int> reported_of_true;
-  std::ifstream detections(out + "/detections.csv");
-  std::getline(detections, line);
-  while (std::getline(detections, line)) {
-    std::stringstream s(line);
-    std::string frame, image, id, u, v;
-    std::getline(s, frame, ',');
-    std::getline(s, image, ',');
-    std::getline(s, id, ',');
-    std::getline(s, u, ',');
-    std::getline(s, v, ',');
-    const Eigen::Vector2d uv(std::stod(u), std::stod(v));
-    int truth = -1;
-    for (const auto& [true_id, p] : footage.truth[std::stoi(frame)]) {
-      if ((p - uv).norm() < 1.0) truth = true_id;
-    }
-    ASSERT_GE(truth, 0) << line;
-    ASSERT_GE(std::stoi(id), 0) << line;
-    const auto [it, inserted] = reported_of_true.emplace(truth, std::stoi(id));
-    EXPECT_EQ(it->second, std::stoi(id)) << "light " << truth << " changed identity: " << line;
-  }
-  EXPECT_EQ(reported_of_true.size(), 8u);
+  ExpectEveryDetectionIdentifiedConsistently(footage, out, 8);
 }
 
 TEST(DetectCli, TheSecondLookFindsAFadedLightAndWhatThePoseDoesNotExplainIsRejected) {
@@ -217,28 +226,7 @@ TEST(DetectCli, FramesWithTooFewLightsForAPoseAreIdentifiedFromTheFramesBefore) 
   EXPECT_EQ(summary["labels"]["precision"], 1.0);
   EXPECT_NE(r.out.find("4 frames without a pose bridged"), std::string::npos) << r.out;
   // Each light keeps the id it had in the posed frames.
-  std::map<int, int> reported_of_true;
-  std::ifstream detections(out + "/detections.csv");
-  std::string line;
-  std::getline(detections, line);
-  while (std::getline(detections, line)) {
-    std::stringstream s(line);
-    std::string frame, image, id, u, v;
-    std::getline(s, frame, ',');
-    std::getline(s, image, ',');
-    std::getline(s, id, ',');
-    std::getline(s, u, ',');
-    std::getline(s, v, ',');
-    const Eigen::Vector2d uv(std::stod(u), std::stod(v));
-    int truth = -1;
-    for (const auto& [true_id, p] : footage.truth[std::stoi(frame)]) {
-      if ((p - uv).norm() < 1.0) truth = true_id;
-    }
-    ASSERT_GE(truth, 0) << line;
-    ASSERT_GE(std::stoi(id), 0) << line;
-    const auto [it, inserted] = reported_of_true.emplace(truth, std::stoi(id));
-    EXPECT_EQ(it->second, std::stoi(id)) << "light " << truth << " changed identity: " << line;
-  }
+  ExpectEveryDetectionIdentifiedConsistently(footage, out, 8);
   // Every bridged frame says so, and the lamp is a rejected candidate with the reason.
   const std::string frames = test::ReadTextFile(out + "/frames.csv");
   const std::string note = "2 identified and 1 unexplained by the poses of the frames from 7 on";
