@@ -19,37 +19,34 @@ struct ProjectedLight {
   int light_id = -1;
   Eigen::Vector3d p_D = Eigen::Vector3d::Zero();
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();
-  Eigen::Matrix<double, 2, 6> J = Eigen::Matrix<double, 2, 6>::Zero();
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   double spacing_px = 0.0;  // to the nearest other light's projection (in the image or not)
   bool near_image = false;  // within the image or image_margin_px of it
 };
 
-// Every light in front of the camera that it can project, in the image or not.
+// Every light in front of the camera that it can project, in the image or not (PredictLights
+// without its image margin).
 std::vector<ProjectedLight> ProjectLights(const PinholeRadtanCamera& camera, const DockModel& dock,
                                           const Pose3& T_C_D,
                                           const Eigen::Matrix<double, 6, 6>& P_pose,
                                           double margin_px) {
-  constexpr double kMinDepth = 0.05;
+  const std::vector<PredictedLight> predicted =
+      PredictLights(dock, camera, T_C_D, P_pose, {}, -std::numeric_limits<double>::infinity());
   std::vector<ProjectedLight> out;
-  for (const DockLight& light : dock.lights) {
-    const Eigen::Vector3d p_C = T_C_D * light.p_D;
-    if (!(p_C.z() > kMinDepth)) continue;
-    const auto uv = camera.Project(p_C, kMinDepth);
-    if (!uv) continue;
+  for (const PredictedLight& p : predicted) {
+    // A light whose projection has no Jacobian (at the lens's fold) is not followed.
+    if (p.covariance.isZero() && !P_pose.isZero()) continue;
     ProjectedLight v;
-    v.near_image = camera.InImage(*uv, margin_px);
-    v.light_id = light.id;
-    v.p_D = light.p_D;
-    v.uv = *uv;
-    v.J = ProjectionPoseJacobian(camera, T_C_D, light.p_D);
-    if (v.J.isZero()) continue;
-    v.covariance = v.J * P_pose * v.J.transpose();
+    v.light_id = p.light_id;
+    v.p_D = dock.FindLight(p.light_id)->p_D;
+    v.uv = p.uv;
+    v.covariance = p.covariance;
+    v.near_image = camera.InImage(p.uv, margin_px);
     v.spacing_px = std::numeric_limits<double>::infinity();
-    for (const DockLight& other : dock.lights) {
-      if (other.id == light.id) continue;
-      const auto other_uv = camera.Project(T_C_D * other.p_D, kMinDepth);
-      if (other_uv) v.spacing_px = std::min(v.spacing_px, (*other_uv - *uv).norm());
+    for (const PredictedLight& other : predicted) {
+      if (other.light_id != p.light_id) {
+        v.spacing_px = std::min(v.spacing_px, (other.uv - p.uv).norm());
+      }
     }
     out.push_back(v);
   }
