@@ -15,8 +15,11 @@
 // off: neither): a tracked chain of poses that a longer chain's walk refutes (it labels more of
 // the frame where they meet) loses its poses ("refuted" in frames.csv), and the frames without a
 // pose are bridged from the chains before and after them: the lights such a walk identifies get
-// their ids, and what it finds far from every light is rejected ("not a light of the dock at the
-// neighbouring frames' pose"); their reason in frames.csv says so. Writes (detect_output.h),
+// their ids, what it finds far from every light is rejected ("not a light of the dock at the
+// neighbouring frames' pose"), and a close light's candidate rejected for its colour alone
+// (RejectedLightCandidate::overrulable: a light within decimetres of the lens whitens its glow)
+// where the walk puts a light becomes that light's detection; their reason in frames.csv says so,
+// and summary.json counts them (bridged_frames.rejected_candidates_accepted). Writes (detect_output.h),
 // flushed frame by frame (a stopped run keeps every frame written before the stop, as it was
 // before the end), and written anew from memory when the end changed anything (each file to a
 // temporary, renamed over the old one; the overlays of the bridged frames are drawn again):
@@ -119,13 +122,14 @@ void DrawOverlay(const cv::Mat& image, const std::vector<LightDetection>& detect
 }
 
 struct WalkRevision {
-  int refuted = 0, identified = 0, unexplained = 0;
+  int refuted = 0, identified = 0, unexplained = 0, accepted = 0;
 };
 
 // The records revised by the walks of the end (two_way_light_bridge.h): a refuted frame loses
 // its pose and identities; a bridged one gets the walk's identities, and what the walk judged no
-// light of the dock moves to its rejected candidates (unless keep_unexplained). Each says so in
-// its reason.
+// light of the dock moves to its rejected candidates (unless keep_unexplained), and a candidate
+// rejected on appearance alone where the walk put a light (FewLightTracker's doubtful candidates)
+// becomes that light's detection. Each says so in its reason.
 WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep_unexplained,
                               std::vector<FrameRecord>* records,
                               std::map<std::string, int>* rejected_reasons) {
@@ -161,13 +165,31 @@ WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep
       ids.push_back(walked.light_ids[i]);
       identified += ids.back() >= 0;
     }
-    revision.identified += identified;
+    int accepted = 0;
+    for (size_t i = 0; i < walked.doubtful.size(); ++i) {
+      if (walked.doubtful_light_ids[i] < 0) continue;
+      const LightDetection& d = walked.doubtful[i];
+      kept.push_back(d);
+      ids.push_back(walked.doubtful_light_ids[i]);
+      ++accepted;
+      record.rejected.erase(
+          std::remove_if(record.rejected.begin(), record.rejected.end(),
+                         [&](const RejectedLightCandidate& r) { return r.uv == d.uv; }),
+          record.rejected.end());
+    }
+    revision.identified += identified + accepted;
     revision.unexplained += unexplained;
+    revision.accepted += accepted;
     const int anchor = (*records)[walked.anchor_frame].index;
     record.reason += (record.reason.empty() ? "" : "; ") + std::to_string(identified) +
                      " identified and " + std::to_string(unexplained) +
                      " unexplained by the poses of the frames from " + std::to_string(anchor) +
                      (anchor > record.index ? " back" : " on");
+    if (accepted > 0) {
+      record.reason += "; " + std::to_string(accepted) +
+                       " candidates that the detector rejected on appearance lie where they put "
+                       "a light and are taken as it";
+    }
     record.detections = std::move(kept);
     record.light_ids = std::move(ids);
   }
@@ -274,6 +296,14 @@ void RunDetect(const DetectOptions& options) {
           pose.rms_px * std::sqrt(pose.num_lights / (2.0 * pose.num_lights - 6.0));
     }
     record.rejected = std::move(frame.rejected);
+    for (const RejectedLightCandidate& r : record.rejected) {
+      if (!r.overrulable) continue;
+      LightDetection d;
+      d.uv = r.uv;
+      d.radius_px = r.sigma_px;
+      d.covariance = r.covariance;
+      record.doubtful.push_back(d);
+    }
     for (const LightDetection& d : frame.unexplained) {
       record.rejected.push_back({d.uv, d.radius_px, "not a light of the dock at the pose"});
     }
@@ -322,6 +352,7 @@ void RunDetect(const DetectOptions& options) {
   // The frames without a pose, from the posed frames beside them (two_way_light_bridge.h); the
   // files written frame by frame are then written anew with what the walks identified.
   int n_bridged = 0, n_bridge_identified = 0, n_bridge_unexplained = 0, n_refuted = 0;
+  int n_bridge_accepted = 0;
   if (!interrupted && options.bridge != "off" && !options.no_tracking) {
     std::vector<BridgedFrame> frames(records.size());
     for (size_t k = 0; k < records.size(); ++k) {
@@ -330,6 +361,7 @@ void RunDetect(const DetectOptions& options) {
       frames[k].covariance_local = records[k].covariance_local;
       frames[k].residual_sigma_px = records[k].residual_sigma_px;
       frames[k].tracked = records[k].tracked;
+      frames[k].doubtful = records[k].doubtful;
       for (const int id : records[k].light_ids) frames[k].identified += id >= 0;
     }
     TwoWayLightBridgeOptions bridge_options;
@@ -342,6 +374,7 @@ void RunDetect(const DetectOptions& options) {
     n_refuted = revision.refuted;
     n_bridge_identified = revision.identified;
     n_bridge_unexplained = revision.unexplained;
+    n_bridge_accepted = revision.accepted;
     if (options.overlay) {
       for (size_t k = 0; k < records.size(); ++k) {
         if (!frames[k].refuted && !frames[k].bridged) continue;
@@ -380,7 +413,8 @@ void RunDetect(const DetectOptions& options) {
   summary["frames_refuted"] = n_refuted;
   summary["bridged_frames"] = {{"frames", n_bridged},
                                {"identified", n_bridge_identified},
-                               {"unexplained", n_bridge_unexplained}};
+                               {"unexplained", n_bridge_unexplained},
+                               {"rejected_candidates_accepted", n_bridge_accepted}};
   summary["second_look"] = {{"guided_detections", n_guided}, {"frames_posed_by_weak_pass", n_weak_pass}};
   summary["colour"] = LightColourName(colour);
   summary["no_pose_reasons"] = reasons;
@@ -401,8 +435,9 @@ void RunDetect(const DetectOptions& options) {
   }
   if (n_bridged > 0) {
     std::printf("  %d frames without a pose bridged by their neighbours' poses: %d lights "
-                "identified, %d detections no light of the dock\n",
-                n_bridged, n_bridge_identified, n_bridge_unexplained);
+                "identified (%d of them candidates the detector had rejected), %d detections no "
+                "light of the dock\n",
+                n_bridged, n_bridge_identified, n_bridge_accepted, n_bridge_unexplained);
   }
   if (!rejected_reasons.empty()) {
     std::vector<std::pair<int, std::string>> by_count;

@@ -102,7 +102,15 @@ std::vector<LightDetection> BlobLightDetector::Detect(const cv::Mat& image,
     const std::string reason =
         CheckLightCandidate(candidate, *core, evidence, has_colour, candidate_checks);
     if (!reason.empty()) {
-      reject(core->uv, reason);
+      if (rejected) {
+        // Only its colour failed (its shape passed): a light too close to show its colour.
+        const bool colour_only =
+            close_light && CheckLightCandidate(candidate, *core, evidence, /*has_colour=*/false,
+                                               candidate_checks)
+                               .empty();
+        rejected->push_back({core->uv, candidate.sigma_px, reason, colour_only,
+                             colour_only ? core->covariance : Eigen::Matrix2d::Zero()});
+      }
       continue;
     }
     std::string overlap;

@@ -15,6 +15,7 @@
 namespace auvdock {
 namespace {
 
+
 struct ProjectedLight {
   int light_id = -1;
   Eigen::Vector3d p_D = Eigen::Vector3d::Zero();
@@ -73,7 +74,8 @@ FewLightTracker::FewLightTracker(const PinholeRadtanCamera& camera, const DockMo
       !(options.unexplained_chi2 >= options.gate_chi2) || !(options.unexplained_floor_px >= 0.0) ||
       !(options.unexplained_spacing_fraction >= 0.0) ||
       !(options.consistency_alpha > 0.0 && options.consistency_alpha < 1.0) ||
-      !(options.pixel_noise_px > 0.0) || !(options.max_sigma_px > 0.0) || options.max_frames < 1 ||
+      !(options.pixel_noise_px > 0.0) || !(options.max_sigma_px > 0.0) ||
+      !(options.guide_spacing_fraction >= 0.0) || options.max_frames < 1 ||
       options.max_unlabelled_frames < 0) {
     throw std::invalid_argument("FewLightTrackerOptions out of range");
   }
@@ -125,7 +127,8 @@ bool FewLightTracker::Start(const std::vector<Pose3>& poses,
   return true;
 }
 
-std::optional<FewLightStep> FewLightTracker::Step(const std::vector<LightDetection>& detections) {
+std::optional<FewLightStep> FewLightTracker::Step(const std::vector<LightDetection>& detections,
+                                                  const std::vector<LightDetection>& doubtful) {
   if (!walking_) return std::nullopt;
   if (frames_ >= options_.max_frames) {
     End("walked " + std::to_string(frames_) + " frames");
@@ -157,15 +160,18 @@ std::optional<FewLightStep> FewLightTracker::Step(const std::vector<LightDetecti
     End("no light of the dock in the image");
     return std::nullopt;
   }
-  // Lights more uncertain than max_sigma_px guide nothing (they are not labelled), but their wide
-  // gates still keep what lies near them from being judged.
+  // Lights more uncertain than max_sigma_px (or guide_spacing_fraction of their spacing) guide
+  // nothing (they are not labelled), but their wide gates still keep what lies near them from
+  // being judged.
   std::vector<bool> guides(lights.size(), false);
   bool any_guide = false;
   for (size_t l = 0; l < lights.size(); ++l) {
     const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(lights[l].covariance)
                                .eigenvalues()
                                .maxCoeff();
-    guides[l] = lights[l].near_image && std::sqrt(std::max(largest, 0.0)) <= options_.max_sigma_px;
+    const double max_sigma =
+        std::max(options_.max_sigma_px, options_.guide_spacing_fraction * lights[l].spacing_px);
+    guides[l] = lights[l].near_image && std::sqrt(std::max(largest, 0.0)) <= max_sigma;
     any_guide |= guides[l] && camera_.InImage(lights[l].uv);
   }
   if (!any_guide) {
@@ -200,13 +206,59 @@ std::optional<FewLightStep> FewLightTracker::Step(const std::vector<LightDetecti
     for (size_t k = 0; k < n_det; ++k) holders += d2[k][only] <= options_.gate_chi2;
     if (holders == 1) labels.emplace_back(j, static_cast<size_t>(only));
   }
+  // A guiding light with no detection in its gate takes a doubtful candidate there: the one
+  // nearest the prediction, when no other light's gate holds it and every other doubtful
+  // candidate in the gate is the same blob at another scale (within its radius).
+  step.doubtful_light_ids.assign(doubtful.size(), -1);
+  std::vector<Eigen::Matrix2d> R_doubtful(doubtful.size());
+  for (size_t k = 0; k < doubtful.size(); ++k) {
+    R_doubtful[k] = PixelCovarianceAtLeast(doubtful[k], noise_px_);
+  }
+  std::vector<std::pair<size_t, size_t>> doubtful_labels;  // (doubtful candidate, light)
+  for (size_t l = 0; l < n_light && !doubtful.empty(); ++l) {
+    if (!guides[l]) continue;
+    bool held = false;
+    for (size_t j = 0; j < n_det; ++j) held |= d2[j][l] <= options_.gate_chi2;
+    if (held) continue;
+    std::vector<std::pair<double, size_t>> in_gate;
+    for (size_t k = 0; k < doubtful.size(); ++k) {
+      const double d2_kl =
+          SquaredMahalanobis(doubtful[k].uv - lights[l].uv, lights[l].covariance + R_doubtful[k]);
+      if (d2_kl <= options_.gate_chi2) in_gate.emplace_back(d2_kl, k);
+    }
+    if (in_gate.empty()) continue;
+    const size_t best = std::min_element(in_gate.begin(), in_gate.end())->second;
+    bool one_blob = true;
+    for (const auto& [unused, k] : in_gate) {
+      one_blob &= (doubtful[k].uv - doubtful[best].uv).norm() <=
+                  std::max(doubtful[best].radius_px, doubtful[k].radius_px);
+    }
+    // Another light that guides and whose gate holds it competes (one that does not guide,
+    // pinned down by nothing seen, may reach anywhere through the linearised projection).
+    bool other_light = false;
+    for (size_t o = 0; o < n_light; ++o) {
+      other_light |= o != l && guides[o] &&
+                     SquaredMahalanobis(doubtful[best].uv - lights[o].uv,
+                                        lights[o].covariance + R_doubtful[best]) <=
+                         options_.gate_chi2;
+    }
+    if (one_blob && !other_light) doubtful_labels.emplace_back(best, l);
+  }
 
   // Iterated update on the labelled lights, the prediction as prior.
-  if (!labels.empty()) {
-    const int n = static_cast<int>(labels.size());
+  struct Observed {
+    Eigen::Vector2d uv;
+    Eigen::Matrix2d R;
+    size_t light;
+  };
+  std::vector<Observed> observed;
+  for (const auto& [j, l] : labels) observed.push_back({detections[j].uv, R[j], l});
+  for (const auto& [k, l] : doubtful_labels) observed.push_back({doubtful[k].uv, R_doubtful[k], l});
+  if (!observed.empty()) {
+    const int n = static_cast<int>(observed.size());
     const Pose3 predicted = T_C_D_;
     Eigen::MatrixXd Rm = Eigen::MatrixXd::Zero(2 * n, 2 * n);
-    for (int i = 0; i < n; ++i) Rm.block<2, 2>(2 * i, 2 * i) = R[labels[i].first];
+    for (int i = 0; i < n; ++i) Rm.block<2, 2>(2 * i, 2 * i) = observed[i].R;
     Eigen::Matrix<double, 12, 1> x = Eigen::Matrix<double, 12, 1>::Zero();
     Eigen::MatrixXd H(2 * n, 12), K;
     double nis = 0.0;
@@ -216,13 +268,13 @@ std::optional<FewLightStep> FewLightTracker::Step(const std::vector<LightDetecti
       H.setZero();
       bool projected = true;
       for (int i = 0; i < n; ++i) {
-        const ProjectedLight& l = lights[labels[i].second];
+        const ProjectedLight& l = lights[observed[i].light];
         const auto uv = camera_.Project(T * l.p_D, 0.05);
         if (!uv) {
           projected = false;
           break;
         }
-        r.segment<2>(2 * i) = detections[labels[i].first].uv - *uv;
+        r.segment<2>(2 * i) = observed[i].uv - *uv;
         H.block<2, 6>(2 * i, 0) = ProjectionPoseJacobian(camera_, T, l.p_D);
       }
       if (!projected) {
@@ -248,12 +300,14 @@ std::optional<FewLightStep> FewLightTracker::Step(const std::vector<LightDetecti
     P_ = (Matrix12::Identity() - K * H) * P_;
     P_ = 0.5 * (P_ + P_.transpose());
     for (const auto& [j, l] : labels) step.light_ids[j] = lights[l].light_id;
-    step.labelled = n;
+    for (const auto& [k, l] : doubtful_labels) step.doubtful_light_ids[k] = lights[l].light_id;
+    step.labelled = static_cast<int>(labels.size());
+    step.labelled_doubtful = static_cast<int>(doubtful_labels.size());
   }
 
   // Detections but none where a light should be: the prediction may have lost the lights (a jerk
   // the rate model cannot follow), so nothing is judged; a few such frames in a row end the walk.
-  if (labels.empty() && n_det > 0) {
+  if (observed.empty() && n_det > 0) {
     if (++unlabelled_frames_ > options_.max_unlabelled_frames) {
       End("lost: " + std::to_string(unlabelled_frames_) +
           " frames in a row with detections and none where a light should be");
@@ -263,7 +317,7 @@ std::optional<FewLightStep> FewLightTracker::Step(const std::vector<LightDetecti
     step.covariance_local = P_.topLeftCorner<6, 6>();
     return step;
   }
-  if (!labels.empty()) unlabelled_frames_ = 0;
+  if (!observed.empty()) unlabelled_frames_ = 0;
   // Verdict, against the prediction's gates (the wider ones), of every light in front of the
   // camera: a model that misplaces a light may put it just outside the image.
   for (size_t j = 0; j < n_det; ++j) {

@@ -93,7 +93,7 @@ class Bridge {
       const int other = chain_of_[k];
       if (other == c) return;
       BridgedFrame& frame = frames_[k];
-      const std::optional<FewLightStep> result = tracker_->Step(frame.detections);
+      const std::optional<FewLightStep> result = tracker_->Step(frame.detections, frame.doubtful);
       if (!result) return;
       if (Stands(k)) {
         Chain& chain = chains_[other];
@@ -115,6 +115,7 @@ class Bridge {
       frame.anchor_frame = end;
       frame.light_ids = result->light_ids;
       frame.unexplained = result->unexplained;
+      frame.doubtful_light_ids = result->doubtful_light_ids;
     }
   }
 

@@ -462,6 +462,46 @@ TEST(BlobLightDetector, AVeryCloseLightIsFoundAndALargeLitPatchIsNot) {
   EXPECT_TRUE(patch_said_why);
 }
 
+// A light within decimetres of the lens whitens its own glow: its shape passes and its colour
+// fails, and such a candidate is marked for a tracked prediction to overrule, with its core's
+// covariance. A small white blob of the same kind is not (it is a fitting or a speck).
+TEST(BlobLightDetector, ACloseLightRejectedForItsColourAloneMayBeOverruled) {
+  cv::Mat image(512, 640, CV_32FC3, cv::Scalar(60, 70, 30));
+  const auto add_white_light = [&](const Eigen::Vector2d& uv, double core_px, double halo_px) {
+    for (int y = 0; y < image.rows; ++y) {
+      for (int x = 0; x < image.cols; ++x) {
+        const double d2 = (x - uv.x()) * (x - uv.x()) + (y - uv.y()) * (y - uv.y());
+        const float level = static_cast<float>(
+            (d2 <= core_px * core_px ? 400.0 : 0.0) + 300.0 * std::exp(-0.5 * d2 / (halo_px * halo_px)));
+        image.at<cv::Vec3f>(y, x) += cv::Vec3f(level, level, level);
+      }
+    }
+  };
+  const Eigen::Vector2d close_uv(300.4, 250.7), small_uv(560.2, 90.6);
+  add_white_light(close_uv, 50.0, 50.0);
+  add_white_light(small_uv, 2.0, 3.0);
+  cv::Mat bgr;
+  image.convertTo(bgr, CV_8UC3);
+  BlobLightDetectorOptions options;
+  options.checks.colour = LightColour::kBlue;
+  std::vector<RejectedLightCandidate> rejected;
+  EXPECT_TRUE(BlobLightDetector(options).Detect(bgr, &rejected).empty());
+  int close_overrulable = 0, small_overrulable = 0;
+  for (const auto& r : rejected) {
+    if (!r.overrulable) {
+      EXPECT_TRUE(r.covariance.isZero());
+      continue;
+    }
+    EXPECT_EQ(r.reason.rfind("wrong colour", 0), 0u) << r.reason;
+    EXPECT_GT(r.sigma_px, options.close_light_min_sigma_px);
+    EXPECT_GT(r.covariance.trace(), 0.0);
+    close_overrulable += (r.uv - close_uv).norm() < 1.0;
+    small_overrulable += (r.uv - small_uv).norm() < 5.0;
+  }
+  EXPECT_GE(close_overrulable, 1);
+  EXPECT_EQ(small_overrulable, 0);
+}
+
 // A large round bright plateau among small lights (a white funnel's interior ringed by LEDs 1.5
 // plateau radii from its centre, in a grey image where no colour tells them apart) is not a light
 // a few decimetres away: that would outshine the others and lie far from them in the image. It

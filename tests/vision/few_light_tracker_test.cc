@@ -106,6 +106,75 @@ TEST_F(FewLightTrackerTest, FollowsTwoLightsForTwentyFramesAndRejectsASpeckFarFr
   }
 }
 
+// A light too close to show its colour: the detector rejects it (a doubtful candidate), and the
+// walk takes it where it predicts a light and no detection lies, never where a detection does.
+TEST_F(FewLightTrackerTest, TakesADoubtfulCandidateOnlyWhereALightIsPredictedAndNothingElseIs) {
+  FewLightTracker tracker(camera_, dock_, 0.1);
+  ASSERT_TRUE(StartFromPoses(&tracker, 0, 5));
+  for (int k = 6; k <= 20; ++k) {
+    const Pose3 T = Truth(k);
+    // Light 0 detected; light 1 only as a doubtful candidate; a doubtful speck far from both.
+    const std::vector<LightDetection> detections = {Detection(Project(T, 0))};
+    const std::vector<LightDetection> doubtful = {
+        Detection(Project(T, 1)), Detection(Project(T, 0) + Eigen::Vector2d(90.0, 60.0))};
+    const std::optional<FewLightStep> step = tracker.Step(detections, doubtful);
+    ASSERT_TRUE(step) << "frame " << k << ": " << tracker.end_reason();
+    EXPECT_EQ(step->light_ids, (std::vector<int>{0})) << "frame " << k;
+    EXPECT_EQ(step->doubtful_light_ids, (std::vector<int>{1, -1})) << "frame " << k;
+    EXPECT_EQ(step->labelled, 1);
+    EXPECT_EQ(step->labelled_doubtful, 1);
+    // Doubtful candidates are never judged: they are rejected already.
+    EXPECT_EQ(step->unexplained, (std::vector<bool>{false}));
+    EXPECT_LT((step->T_C_D.p - Truth(k).p).norm(), 0.1) << "frame " << k;
+  }
+  // Where a detection lies in light 1's gate, a doubtful candidate beside it is not taken.
+  const Pose3 T = Truth(21);
+  const std::optional<FewLightStep> step =
+      tracker.Step({Detection(Project(T, 0)), Detection(Project(T, 1))},
+                   {Detection(Project(T, 1) + Eigen::Vector2d(2.0, 0.0))});
+  ASSERT_TRUE(step) << tracker.end_reason();
+  EXPECT_EQ(step->light_ids, (std::vector<int>{0, 1}));
+  EXPECT_EQ(step->doubtful_light_ids, (std::vector<int>{-1}));
+}
+
+// A prediction too uncertain in pixels still guides while it is small against the light's
+// spacing in the image (a light within a metre moves by many pixels per frame).
+TEST_F(FewLightTrackerTest, APredictionGuidesWhileSmallAgainstTheLightsSpacing) {
+  FewLightTrackerOptions options;
+  options.max_sigma_px = 0.2;  // below every prediction's sigma here
+  options.guide_spacing_fraction = 0.0;
+  FewLightTracker strict(camera_, dock_, 0.1, options);
+  ASSERT_TRUE(StartFromPoses(&strict, 0, 5));
+  EXPECT_FALSE(strict.Step(TwoLightsAndASpeck(Truth(6))));
+  EXPECT_EQ(strict.end_reason(), "the prediction is too uncertain to guide");
+  options.guide_spacing_fraction = 0.2;
+  FewLightTracker relative(camera_, dock_, 0.1, options);
+  ASSERT_TRUE(StartFromPoses(&relative, 0, 5));
+  const std::optional<FewLightStep> step = relative.Step(TwoLightsAndASpeck(Truth(6)));
+  ASSERT_TRUE(step) << relative.end_reason();
+  EXPECT_EQ(step->light_ids, (std::vector<int>{0, 1, -1}));
+}
+
+// Two doubtful candidates in one light's gate that are not one blob: neither is taken.
+TEST_F(FewLightTrackerTest, NeverGuessesBetweenTwoDoubtfulCandidates) {
+  FewLightTracker tracker(camera_, dock_, 0.1);
+  ASSERT_TRUE(StartFromPoses(&tracker, 0, 5));
+  const Pose3 T = Truth(6);
+  std::vector<LightDetection> doubtful = {Detection(Project(T, 1)),
+                                          Detection(Project(T, 1) + Eigen::Vector2d(2.5, 0.0))};
+  for (LightDetection& d : doubtful) d.radius_px = 1.0;  // two small blobs 2.5 px apart
+  const std::optional<FewLightStep> step = tracker.Step({Detection(Project(T, 0))}, doubtful);
+  ASSERT_TRUE(step) << tracker.end_reason();
+  EXPECT_EQ(step->doubtful_light_ids, (std::vector<int>{-1, -1}));
+  // The same blob at a larger scale (within its radius) is one candidate: the nearer is taken.
+  const Pose3 T7 = Truth(7);
+  doubtful = {Detection(Project(T7, 1) + Eigen::Vector2d(2.0, 0.0)), Detection(Project(T7, 1))};
+  doubtful[0].radius_px = 20.0;
+  const std::optional<FewLightStep> next = tracker.Step({Detection(Project(T7, 0))}, doubtful);
+  ASSERT_TRUE(next) << tracker.end_reason();
+  EXPECT_EQ(next->doubtful_light_ids, (std::vector<int>{-1, 1}));
+}
+
 TEST_F(FewLightTrackerTest, NeverGuessesBetweenTwoDetectionsInOneLightsGate) {
   FewLightTracker tracker(camera_, dock_, 0.1);
   ASSERT_TRUE(StartFromPoses(&tracker, 0, 5));

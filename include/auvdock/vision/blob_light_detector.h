@@ -81,6 +81,12 @@ struct RejectedLightCandidate {
   Eigen::Vector2d uv = Eigen::Vector2d::Zero();
   double sigma_px = 0.0;
   std::string reason;
+  // At a close light's scale (above close_light_min_sigma_px), with a light's shape, and
+  // rejected for its colour alone: a light within decimetres of the lens whitens its own glow,
+  // and the prediction of a light tracked to there may overrule the colour (few_light_tracker.h).
+  // Its core's centroid covariance then (zero otherwise).
+  bool overrulable = false;
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
 };
 
 class BlobLightDetector {

@@ -32,10 +32,22 @@
 //            start poses' own residual per axis): a camera model that fits the lights to a
 //            pixel (a real lens, a hand-measured layout) misses by as much on the walk.
 //   label:   j is L when L is the only light whose gate holds j and j the only detection in L's
-//            gate (never a guess between two), and L's 1-sigma is at most max_sigma_px (a light
-//            that the lights seen do not pin down, e.g. the T's bar while only its stem is in
-//            view, is not labelled; its wide gate still counts for the verdict).
-//   update:  Gauss-Newton on the labelled lights with the prediction as prior (an iterated
+//            gate (never a guess between two), and L guides: its 1-sigma is at most max_sigma_px
+//            or guide_spacing_fraction of its distance to the nearest other light's projection
+//            (a light that the lights seen do not pin down, e.g. the T's bar while only its stem
+//            is in view, is not labelled; its wide gate still counts for the verdict). The
+//            spacing term is for lights within a metre or so: there the vehicle's acceleration
+//            alone moves a light by 10-20 px a frame, while the nearest other light is hundreds
+//            of pixels away.
+//   doubtful: a guiding light with no detection in its gate may take a doubtful candidate (one
+//            the detector rejected on appearance alone: a light too close to the lens to show
+//            its colour, blob_light_detector.h) in its gate, with that candidate's covariance:
+//            the nearest to the prediction, when every other doubtful candidate in the gate is
+//            the same blob at another scale (within its radius) and no other guiding light's
+//            gate holds it. Doubtful candidates are never judged (they are rejected already).
+//            On the randomised renders the downward camera, landed, sees one light filling the
+//            image, whitened: the walk carries it on from the poses before touchdown.
+//   update:  Gauss-Newton on the labelled lights (detections and doubtful candidates) with the prediction as prior (an iterated
 //            Kalman update); the normalised innovation squared over them must pass chi-square
 //            with 2 n degrees of freedom at consistency_alpha, or the walk is lost (a wrong label
 //            the gate let through, or motion the rate model cannot follow).
@@ -50,8 +62,8 @@
 //            is not judged: the prediction may have lost the lights (a jerk the rate model
 //            cannot follow) rather than every detection being clutter; more than
 //            max_unlabelled_frames such frames in a row end the walk.
-// The walk ends when the prediction no longer guides (no light in the image with a 1-sigma of at
-// most max_sigma_px, or no light within image_margin_px of the image), after max_frames, or when lost.
+// The walk ends when the prediction no longer guides (no light in the image guides, or no light
+// within image_margin_px of the image), after max_frames, or when lost.
 //
 // Units: pixels (raw, distorted image), metres, radians; frames: T_C_D maps dock coordinates into
 // the camera frame (OpenCV).
@@ -82,7 +94,8 @@ struct FewLightTrackerOptions {
   double unexplained_spacing_fraction = 0.35;
   double consistency_alpha = 1e-4;
   double pixel_noise_px = 0.3;      // floor of a detection's sigma (CameraCalibration)
-  double max_sigma_px = 10.0;       // a prediction this uncertain no longer guides
+  double max_sigma_px = 10.0;       // a prediction this uncertain no longer guides ...
+  double guide_spacing_fraction = 0.2;  // ... unless within this fraction of its spacing
   double image_margin_px = -20.0;   // lights this far outside the image are still judged
   int max_frames = 150;
   int max_unlabelled_frames = 2;
@@ -92,7 +105,9 @@ struct FewLightTrackerOptions {
 struct FewLightStep {
   std::vector<int> light_ids;    // per detection: dock light id or -1
   std::vector<bool> unexplained;  // per detection: no light of the dock at this pose
-  int labelled = 0;
+  std::vector<int> doubtful_light_ids;  // per doubtful candidate: dock light id or -1
+  int labelled = 0;           // detections labelled
+  int labelled_doubtful = 0;  // doubtful candidates labelled
   Pose3 T_C_D;
   Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
 };
@@ -113,8 +128,11 @@ class FewLightTracker {
   bool Start(const std::vector<Pose3>& poses, const std::vector<Matrix6>& covariances,
              double residual_sigma_px = 0.0);
 
-  // The next frame in walking order. Nothing when the walk has ended (why: end_reason()).
-  std::optional<FewLightStep> Step(const std::vector<LightDetection>& detections);
+  // The next frame in walking order: its detections and, optionally, its doubtful candidates
+  // (what the detector rejected on appearance alone, each with its centroid covariance). Nothing
+  // when the walk has ended (why: end_reason()).
+  std::optional<FewLightStep> Step(const std::vector<LightDetection>& detections,
+                                   const std::vector<LightDetection>& doubtful = {});
 
   bool walking() const { return walking_; }
   const std::string& end_reason() const { return end_reason_; }

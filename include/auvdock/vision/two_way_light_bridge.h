@@ -19,6 +19,8 @@
 //    standing chain's pose (a chain too short to start a walk is walked through; its own labels
 //    stay) or until the walk ends. A frame reached by two walks takes the labels of the one whose
 //    posed frames are nearer (fewer frames walked).
+// A frame's doubtful candidates (FewLightTracker::Step) that a walk puts a light on are that
+// light's; nothing else of them is used.
 // The dock entering the downward camera's view shows 1-3 lights among the deck's fittings for
 // tens of frames before a pose of its own is possible; the poses that follow identify them, and
 // what they leave far from every light is no light of the dock.
@@ -50,6 +52,8 @@ struct BridgedFrame {
   // The pose's residual per axis, a posteriori: rms_px sqrt(n / (2 n - 6)) for n lights (0:
   // unknown); a walk's detections are judged with the median of its start poses' at least.
   double residual_sigma_px = 0.0;
+  // Candidates the detector rejected on appearance alone (FewLightTracker::Step's doubtful ones).
+  std::vector<LightDetection> doubtful;
   // Out: a frame whose pose a longer chain refuted (its pose is to be withdrawn) ...
   bool refuted = false;
   int refuted_by = -1;  // the first or last frame of the chain whose walk refuted it
@@ -58,6 +62,7 @@ struct BridgedFrame {
   int anchor_frame = -1;           // the posed frame the walk started next to
   std::vector<int> light_ids;       // per detection: dock light id or -1
   std::vector<bool> unexplained;    // per detection: no light of the dock at the walk's pose
+  std::vector<int> doubtful_light_ids;  // per doubtful candidate: the light the walk put there, or -1
 };
 
 struct TwoWayLightBridgeOptions {
