@@ -145,8 +145,14 @@ std::optional<FewLightStep> FewLightTracker::Step(const std::vector<LightDetecti
                              per_frame +
                          omega_.norm() * v_.norm();
   T_C_D_ = Pose3(ExpQuaternion(omega_) * T_C_D_.q, T_C_D_.p + v_);
+  // The rate persists for about acceleration_time_s (first-order Gauss-Markov): what no light
+  // observes (the range to a single light) stops changing instead of running on.
+  const double rho = std::exp(-dt_ / options_.acceleration_time_s);
+  omega_ *= rho;
+  v_ *= rho;
   Matrix12 F = Matrix12::Identity();
   F.block<6, 6>(0, 6).setIdentity();
+  F.bottomRightCorner<6, 6>() *= rho;
   P_ = F * P_ * F.transpose();
   P_.block<3, 3>(6, 6) += sigma_omega * sigma_omega * Eigen::Matrix3d::Identity();
   P_.block<3, 3>(9, 9) += sigma_v * sigma_v * Eigen::Matrix3d::Identity();
@@ -196,12 +202,12 @@ std::optional<FewLightStep> FewLightTracker::Step(const std::vector<LightDetecti
   for (size_t j = 0; j < n_det; ++j) {
     int only = -1, count = 0;
     for (size_t l = 0; l < n_light; ++l) {
-      if (d2[j][l] <= options_.gate_chi2) {
+      if (guides[l] && d2[j][l] <= options_.gate_chi2) {
         only = static_cast<int>(l);
         ++count;
       }
     }
-    if (count != 1 || !guides[only]) continue;
+    if (count != 1) continue;
     int holders = 0;
     for (size_t k = 0; k < n_det; ++k) holders += d2[k][only] <= options_.gate_chi2;
     if (holders == 1) labels.emplace_back(j, static_cast<size_t>(only));

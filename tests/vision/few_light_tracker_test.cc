@@ -155,6 +155,31 @@ TEST_F(FewLightTrackerTest, APredictionGuidesWhileSmallAgainstTheLightsSpacing) 
   EXPECT_EQ(step->light_ids, (std::vector<int>{0, 1, -1}));
 }
 
+// The downward camera lands over a light: it descends 2 cm a frame, then stops 0.46 m above it,
+// and sees that light alone. One light does not observe the range; the walk's rate decays
+// (acceleration_time_s) instead of carrying the descent on until the light is "behind" the lens.
+TEST_F(FewLightTrackerTest, FollowsTheOneLightUnderALandedCamera) {
+  const Eigen::Vector3d light_D = dock_.lights[0].p_D;
+  const auto above = [&](int k) {  // looking down (camera z = dock z, down), axes aligned
+    const double height = 0.7 - 0.02 * std::min(k, 12);
+    return Pose3(Eigen::Quaterniond::Identity(), -(light_D - Eigen::Vector3d(0.0, 0.0, height)));
+  };
+  FewLightTracker tracker(camera_, dock_, 0.1);
+  std::vector<Pose3> poses;
+  std::vector<Matrix6> covariances;
+  for (int k = 0; k <= 5; ++k) {
+    poses.push_back(Measured(above(k)));
+    covariances.push_back(PnpCovariance());
+  }
+  ASSERT_TRUE(tracker.Start(poses, covariances));
+  for (int k = 6; k <= 60; ++k) {
+    const Eigen::Vector2d uv = *camera_.Project(above(k) * light_D);
+    const std::optional<FewLightStep> step = tracker.Step({Detection(uv)});
+    ASSERT_TRUE(step) << "frame " << k << ": " << tracker.end_reason();
+    EXPECT_EQ(step->light_ids, (std::vector<int>{0})) << "frame " << k;
+  }
+}
+
 // Two doubtful candidates in one light's gate that are not one blob: neither is taken.
 TEST_F(FewLightTrackerTest, NeverGuessesBetweenTwoDoubtfulCandidates) {
   FewLightTracker tracker(camera_, dock_, 0.1);

@@ -5,8 +5,11 @@
 // A live system has the IMU for this (the window's prediction, prediction_association.h); a
 // camera on its own has the motion of its last poses.
 //
-// State: T_C_D and its change per frame (omega, v), a constant rate over a few frames:
-//   R_{k+1} = Exp(omega) R_k,  p_{k+1} = p_k + v.
+// State: T_C_D and its change per frame (omega, v), a rate that persists for about tau =
+// acceleration_time_s (first-order Gauss-Markov, rho = exp(-dt / tau) per frame):
+//   R_{k+1} = Exp(omega_k) R_k,  p_{k+1} = p_k + v_k,  (omega, v)_{k+1} = rho (omega, v)_k + noise.
+// What no light observes (the range to a single light under the lens) then stops changing after
+// ~tau instead of running on at the last rate.
 // (Walking backward in time is the same with the frames in reverse order.) Error state
 // x = (dtheta, dp, domega, dv), the pose perturbed on the left as in SolvePnp
 // (R <- Exp(dtheta) R, p <- p + dp). A Kalman filter on x:
@@ -15,7 +18,8 @@
 //            (rotations as Log(R_i R_last^T)) against the frame index, with covariance
 //            12 / (m (m^2 - 1)) times their mean PnP covariance; the pose is the last one with its
 //            own covariance (the two taken as uncorrelated).
-//   predict: pose += rate; P <- F P F^T + G, F = [[I, I], [0, I]], G = diag(0, Q): the rate's
+//   predict: pose += rate, rate *= rho; P <- F P F^T + G, F = [[I, I], [0, rho I]], G =
+//            diag(0, Q): the rate's
 //            change per frame, a white-noise acceleration whose spectral density is the
 //            vehicle's largest acceleration squared times acceleration_time_s (how long such an
 //            acceleration lasts), over the frame interval dt:
@@ -31,11 +35,12 @@
 //            covariance with every eigenvalue at least sigma^2, sigma = max(pixel_noise_px, the
 //            start poses' own residual per axis): a camera model that fits the lights to a
 //            pixel (a real lens, a hand-measured layout) misses by as much on the walk.
-//   label:   j is L when L is the only light whose gate holds j and j the only detection in L's
-//            gate (never a guess between two), and L guides: its 1-sigma is at most max_sigma_px
-//            or guide_spacing_fraction of its distance to the nearest other light's projection
-//            (a light that the lights seen do not pin down, e.g. the T's bar while only its stem
-//            is in view, is not labelled; its wide gate still counts for the verdict). The
+//   label:   j is L when L is the only guiding light whose gate holds j and j the only detection
+//            in L's gate (never a guess between two); L guides when its 1-sigma is at most
+//            max_sigma_px or guide_spacing_fraction of its distance to the nearest other light's
+//            projection (a light that the lights seen do not pin down, e.g. the T's bar while only its stem
+//            is in view, guides nothing: it is not labelled, and its linearised gate, which may
+//            reach anywhere, competes for no detection, but still counts for the verdict). The
 //            spacing term is for lights within a metre or so: there the vehicle's acceleration
 //            alone moves a light by 10-20 px a frame, while the nearest other light is hundreds
 //            of pixels away.
@@ -47,8 +52,8 @@
 //            gate holds it. Doubtful candidates are never judged (they are rejected already).
 //            On the randomised renders the downward camera, landed, sees one light filling the
 //            image, whitened: the walk carries it on from the poses before touchdown.
-//   update:  Gauss-Newton on the labelled lights (detections and doubtful candidates) with the prediction as prior (an iterated
-//            Kalman update); the normalised innovation squared over them must pass chi-square
+//   update:  Gauss-Newton on the labelled lights (detections and doubtful candidates) with the
+//            prediction as prior (an iterated Kalman update); the normalised innovation squared over them must pass chi-square
 //            with 2 n degrees of freedom at consistency_alpha, or the walk is lost (a wrong label
 //            the gate let through, or motion the rate model cannot follow).
 //   verdict: a detection outside every in-view light's gate at unexplained_chi2, farther than
