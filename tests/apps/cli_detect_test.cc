@@ -51,8 +51,10 @@ struct Footage {
 // faded_light, that light is a dim blue blob from frame 1 on (below the full-image response), and
 // a blue LED that is not the dock's shines beside the ring (a lamp on the deck, say). From frame
 // partial_from on, only the dock file's first two lights are drawn (the rest out of the beam),
-// and the lamp.
-void MakeFootage(Footage* footage, int frames, int faded_light = -1, int partial_from = -1) {
+// and the lamp; with whitened_second, only the second, as a wide white glow (a light a few
+// decimetres from the lens).
+void MakeFootage(Footage* footage, int frames, int faded_light = -1, int partial_from = -1,
+                 bool whitened_second = false) {
   DockModel dock = LoadDockModel(std::string(AUVDOCK_SOURCE_DIR) + "/data/docks/ring_8.yaml");
   dock.light_colour = "blue";
   SaveDockModel(dock, footage->dir / "dock.yaml");
@@ -66,7 +68,9 @@ void MakeFootage(Footage* footage, int frames, int faded_light = -1, int partial
     cv::Mat image(480, 640, CV_32FC3, cv::Scalar(30, 95, 90));
     std::vector<std::pair<int, Eigen::Vector2d>> seen;
     const bool partial = partial_from >= 0 && f >= partial_from;
-    for (const DockLight& light : dock.lights) {
+    for (size_t index = 0; index < dock.lights.size(); ++index) {
+      const DockLight& light = dock.lights[index];
+      if (partial && whitened_second && index != 1) continue;  // the second light alone
       if (partial && seen.size() == 2) break;
       const Eigen::Vector3d p = T_C_D * light.p_D;
       const Eigen::Vector2d uv(kF * p.x() / p.z() + kCx, kF * p.y() / p.z() + kCy);
@@ -77,6 +81,18 @@ void MakeFootage(Footage* footage, int frames, int faded_light = -1, int partial
             const double d2 = (u - uv.x()) * (u - uv.x()) + (v - uv.y()) * (v - uv.y());
             const float w = static_cast<float>(std::exp(-d2 / (2.0 * 2.5 * 2.5)));
             image.at<cv::Vec3f>(v, u) += cv::Vec3f(150.0f * w, 60.0f * w, 10.0f * w);
+          }
+        }
+        continue;
+      }
+      if (partial && whitened_second) {
+        // A light within decimetres of the lens: a wide saturated glow that shows no colour.
+        for (int v = 0; v < image.rows; ++v) {
+          for (int u = 0; u < image.cols; ++u) {
+            const double d2 = (u - uv.x()) * (u - uv.x()) + (v - uv.y()) * (v - uv.y());
+            const float level = static_cast<float>((d2 <= 35.0 * 35.0 ? 400.0 : 0.0) +
+                                                   300.0 * std::exp(-d2 / (2.0 * 35.0 * 35.0)));
+            image.at<cv::Vec3f>(v, u) += cv::Vec3f(level, level, level);
           }
         }
         continue;
@@ -247,6 +263,36 @@ TEST(DetectCli, FramesWithTooFewLightsForAPoseAreIdentifiedFromTheFramesBefore) 
   summary = nlohmann::json::parse(test::ReadTextFile(off + "/summary.json"));
   EXPECT_EQ(summary["bridged_frames"]["frames"], 0);
   EXPECT_NEAR(summary["labels"]["precision"].get<double>(), 1.0 - 4.0 / (8 * 8 + 4 * 3), 1e-9);
+}
+
+// The same, with only the second light in the frames with too few lights, whitened by its own
+// glow (as a light a few decimetres from the lens): the detector rejects it for its colour, and
+// the walk from the posed frames takes it as that light.
+TEST(DetectCli, AWhitenedCloseLightIsTakenWhereTheWalkPutsIt) {
+  Footage footage;
+  std::filesystem::create_directories(footage.dir / "frames");
+  MakeFootage(&footage, 12, /*faded_light=*/-1, /*partial_from=*/8, /*whitened_second=*/true);
+  const std::string out = footage.dir / "out";
+  test::CommandResult r = test::RunAuvdock(DetectArgs(footage, out));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const nlohmann::json summary = nlohmann::json::parse(test::ReadTextFile(out + "/summary.json"));
+  EXPECT_EQ(summary["bridged_frames"]["frames"], 4);
+  EXPECT_EQ(summary["bridged_frames"]["rejected_candidates_accepted"], 4);
+  EXPECT_EQ(summary["bridged_frames"]["identified"], 4);
+  EXPECT_EQ(summary["labels"]["precision"], 1.0);
+  ExpectEveryDetectionIdentifiedConsistently(footage, out, 8);
+  const std::string frames = test::ReadTextFile(out + "/frames.csv");
+  EXPECT_NE(frames.find("1 candidates that the detector rejected on appearance lie where they put "
+                        "a light and are taken as it"),
+            std::string::npos)
+      << frames;
+  // With --bridge off nothing takes it: the rejected glow stays rejected.
+  const std::string off = footage.dir / "off";
+  std::vector<std::string> args = DetectArgs(footage, off);
+  args.insert(args.end(), {"--bridge", "off"});
+  r = test::RunAuvdock(args);
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(test::ReadTextFile(off + "/rejected.csv").find("wrong colour"), std::string::npos);
 }
 
 TEST(DetectCli, GravityResolvesAnUprightRing) {

@@ -274,6 +274,32 @@ TEST_F(FewLightTrackerTest, TheBridgeWalksBothWaysFromAPosedRunAndThroughALonePo
   for (int k = 0; k < 6; ++k) EXPECT_FALSE(forward[k].bridged) << "frame " << k;
 }
 
+// Frames after the posed run where light 1 is only a doubtful candidate (rejected for its
+// colour): the bridge puts light 1 on it; a doubtful speck stays unlabelled.
+TEST_F(FewLightTrackerTest, TheBridgePutsALightOnADoubtfulCandidate) {
+  std::vector<BridgedFrame> frames(14);
+  for (int k = 0; k < 14; ++k) {
+    const Pose3 T = Truth(k);
+    if (k < 6) {
+      frames[k].detections = AllLights(T);
+      frames[k].T_C_D = Measured(T);
+      frames[k].covariance_local = PnpCovariance();
+      frames[k].tracked = k > 0;
+      frames[k].identified = static_cast<int>(frames[k].detections.size());
+      continue;
+    }
+    frames[k].detections = {Detection(Project(T, 0))};
+    frames[k].doubtful = {Detection(Project(T, 0) + Eigen::Vector2d(90.0, 60.0)),
+                          Detection(Project(T, 1))};
+  }
+  EXPECT_EQ(BridgeFramesWithoutPose(camera_, dock_, 0.1, {}, &frames), 8);
+  for (int k = 6; k < 14; ++k) {
+    ASSERT_TRUE(frames[k].bridged) << "frame " << k;
+    EXPECT_EQ(frames[k].light_ids, (std::vector<int>{0})) << "frame " << k;
+    EXPECT_EQ(frames[k].doubtful_light_ids, (std::vector<int>{-1, 1})) << "frame " << k;
+  }
+}
+
 // A chain of 20 true poses (frames 10-29) after a chain of 6 tracked poses (4-9) whose labels
 // take one light and three specks for the dock, 1 m off, while the five other lights stay
 // unexplained beside them (as tracking carried one in the renders): walking back from the longer chain labels more of frame 9 than its own pose did,
