@@ -19,8 +19,8 @@
 // neighbouring frames' pose"), and a close light's candidate rejected for its colour alone
 // (RejectedLightCandidate::overrulable: a light within decimetres of the lens whitens its glow)
 // where the walk puts a light becomes that light's detection; their reason in frames.csv says so,
-// and summary.json counts them (bridged_frames.rejected_candidates_accepted). Writes (detect_output.h),
-// flushed frame by frame (a stopped run keeps every frame written before the stop, as it was
+// and summary.json counts them (bridged_frames.rejected_candidates_accepted). Writes
+// (detect_output.h), flushed frame by frame (a stopped run keeps every frame written before the stop, as it was
 // before the end), and written anew from memory when the end changed anything (each file to a
 // temporary, renamed over the old one; the overlays of the bridged frames are drawn again):
 //   OUTDIR/detections.csv  frame,image,light_id,u,v,radius,score,cov_uu,cov_uv,cov_vv,at_border

@@ -15,7 +15,6 @@
 namespace auvdock {
 namespace {
 
-
 struct ProjectedLight {
   int light_id = -1;
   Eigen::Vector3d p_D = Eigen::Vector3d::Zero();

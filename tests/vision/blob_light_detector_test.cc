@@ -471,8 +471,9 @@ TEST(BlobLightDetector, ACloseLightRejectedForItsColourAloneMayBeOverruled) {
     for (int y = 0; y < image.rows; ++y) {
       for (int x = 0; x < image.cols; ++x) {
         const double d2 = (x - uv.x()) * (x - uv.x()) + (y - uv.y()) * (y - uv.y());
-        const float level = static_cast<float>(
-            (d2 <= core_px * core_px ? 400.0 : 0.0) + 300.0 * std::exp(-0.5 * d2 / (halo_px * halo_px)));
+        const float level =
+            static_cast<float>((d2 <= core_px * core_px ? 400.0 : 0.0) +
+                               300.0 * std::exp(-0.5 * d2 / (halo_px * halo_px)));
         image.at<cv::Vec3f>(y, x) += cv::Vec3f(level, level, level);
       }
     }

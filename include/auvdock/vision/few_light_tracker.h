@@ -18,11 +18,11 @@
 //            (rotations as Log(R_i R_last^T)) against the frame index, with covariance
 //            12 / (m (m^2 - 1)) times their mean PnP covariance; the pose is the last one with its
 //            own covariance (the two taken as uncorrelated).
-//   predict: pose += rate, rate *= rho; P <- F P F^T + G, F = [[I, I], [0, rho I]], G =
-//            diag(0, Q): the rate's
-//            change per frame, a white-noise acceleration whose spectral density is the
-//            vehicle's largest acceleration squared times acceleration_time_s (how long such an
-//            acceleration lasts), over the frame interval dt:
+//   predict: pose += rate, rate *= rho; P <- F P F^T + G, F = [[I, I], [0, rho I]],
+//            G = diag(0, Q): the rate's change per frame, a white-noise acceleration whose
+//            spectral density is the vehicle's largest acceleration squared times
+//            acceleration_time_s (how long such an acceleration lasts), over the frame interval
+//            dt:
 //            sigma_omega = max_angular_acceleration sqrt(tau dt^3), sigma_v = (max_acceleration
 //            + max_angular_acceleration |p|) sqrt(tau dt^3) + |omega| |v| (a turn moves the
 //            dock's origin in the camera frame by its distance, and turns the rate v). Taken
@@ -38,9 +38,10 @@
 //   label:   j is L when L is the only guiding light whose gate holds j and j the only detection
 //            in L's gate (never a guess between two); L guides when its 1-sigma is at most
 //            max_sigma_px or guide_spacing_fraction of its distance to the nearest other light's
-//            projection (a light that the lights seen do not pin down, e.g. the T's bar while only its stem
-//            is in view, guides nothing: it is not labelled, and its linearised gate, which may
-//            reach anywhere, competes for no detection, but still counts for the verdict). The
+//            projection (a light that the lights seen do not pin down, e.g. the T's bar while
+//            only its stem is in view, guides nothing: it is not labelled, and its linearised
+//            gate, which may reach anywhere, competes for no detection, but still counts for the
+//            verdict). The
 //            spacing term is for lights within a metre or so: there the vehicle's acceleration
 //            alone moves a light by 10-20 px a frame, while the nearest other light is hundreds
 //            of pixels away.
@@ -53,9 +54,10 @@
 //            On the randomised renders the downward camera, landed, sees one light filling the
 //            image, whitened: the walk carries it on from the poses before touchdown.
 //   update:  Gauss-Newton on the labelled lights (detections and doubtful candidates) with the
-//            prediction as prior (an iterated Kalman update); the normalised innovation squared over them must pass chi-square
-//            with 2 n degrees of freedom at consistency_alpha, or the walk is lost (a wrong label
-//            the gate let through, or motion the rate model cannot follow).
+//            prediction as prior (an iterated Kalman update); the normalised innovation squared
+//            over them must pass chi-square with 2 n degrees of freedom at consistency_alpha, or
+//            the walk is lost (a wrong label the gate let through, or motion the rate model
+//            cannot follow).
 //   verdict: a detection outside every in-view light's gate at unexplained_chi2, farther than
 //            unexplained_floor_px from every light and farther than unexplained_spacing_fraction
 //            of each light's distance to its nearest neighbour's projection, is no light of the

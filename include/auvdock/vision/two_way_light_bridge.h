@@ -62,7 +62,7 @@ struct BridgedFrame {
   int anchor_frame = -1;           // the posed frame the walk started next to
   std::vector<int> light_ids;       // per detection: dock light id or -1
   std::vector<bool> unexplained;    // per detection: no light of the dock at the walk's pose
-  std::vector<int> doubtful_light_ids;  // per doubtful candidate: the light the walk put there, or -1
+  std::vector<int> doubtful_light_ids;  // per doubtful candidate: the walk's light there, or -1
 };
 
 struct TwoWayLightBridgeOptions {
