@@ -307,7 +307,6 @@ std::optional<FewLightStep> FewLightTracker::Step(const std::vector<LightDetecti
     for (const auto& [j, l] : labels) step.light_ids[j] = lights[l].light_id;
     for (const auto& [k, l] : doubtful_labels) step.doubtful_light_ids[k] = lights[l].light_id;
     step.labelled = static_cast<int>(labels.size());
-    step.labelled_doubtful = static_cast<int>(doubtful_labels.size());
   }
 
   // Detections but none where a light should be: the prediction may have lost the lights (a jerk

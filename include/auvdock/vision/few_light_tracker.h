@@ -113,8 +113,7 @@ struct FewLightStep {
   std::vector<int> light_ids;    // per detection: dock light id or -1
   std::vector<bool> unexplained;  // per detection: no light of the dock at this pose
   std::vector<int> doubtful_light_ids;  // per doubtful candidate: dock light id or -1
-  int labelled = 0;           // detections labelled
-  int labelled_doubtful = 0;  // doubtful candidates labelled
+  int labelled = 0;  // detections labelled
   Pose3 T_C_D;
   Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
 };
