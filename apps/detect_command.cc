@@ -17,8 +17,9 @@
 // pose are bridged from the chains before and after them: the lights such a walk identifies get
 // their ids, what it finds far from every light is rejected ("not a light of the dock at the
 // neighbouring frames' pose"), and a close light's candidate rejected for its colour alone
-// (RejectedLightCandidate::overrulable: a light within decimetres of the lens whitens its glow)
-// where the walk puts a light becomes that light's detection; their reason in frames.csv says so,
+// (RejectedLightCandidate::overrulable: a light within decimetres of the lens whitens its glow),
+// or a saturated disc wider than any blob (saturated_disc.h), where the walk puts a light becomes
+// that light's detection; their reason in frames.csv says so,
 // and summary.json counts them (bridged_frames.rejected_candidates_accepted). Writes
 // (detect_output.h), flushed frame by frame (a stopped run keeps every frame written before the stop, as it was
 // before the end), and written anew from memory when the end changed anything (each file to a
@@ -69,6 +70,7 @@
 #include "auvdock/io/light_labels_csv.h"
 #include "auvdock/io/staged_directory.h"
 #include "auvdock/vision/mono_light_pipeline.h"
+#include "auvdock/vision/saturated_disc.h"
 #include "auvdock/vision/two_way_light_bridge.h"
 
 namespace fs = std::filesystem;
@@ -128,8 +130,8 @@ struct WalkRevision {
 // The records revised by the walks of the end (two_way_light_bridge.h): a refuted frame loses
 // its pose and identities; a bridged one gets the walk's identities, and what the walk judged no
 // light of the dock moves to its rejected candidates (unless keep_unexplained), and a candidate
-// rejected on appearance alone where the walk put a light (FewLightTracker's doubtful candidates)
-// becomes that light's detection. Each says so in its reason.
+// rejected on appearance alone, or a saturated disc, where the walk put a light
+// (FewLightTracker's doubtful candidates) becomes that light's detection. Each says so in its reason.
 WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep_unexplained,
                               std::vector<FrameRecord>* records,
                               std::map<std::string, int>* rejected_reasons) {
@@ -187,8 +189,8 @@ WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep
                      (anchor > record.index ? " back" : " on");
     if (accepted > 0) {
       record.reason += "; " + std::to_string(accepted) +
-                       " candidates that the detector rejected on appearance lie where they put "
-                       "a light and are taken as it";
+                       " candidates that the detector did not take (rejected on appearance, or a "
+                       "saturated disc) lie where they put a light and are taken as it";
     }
     record.detections = std::move(kept);
     record.light_ids = std::move(ids);
@@ -304,6 +306,8 @@ void RunDetect(const DetectOptions& options) {
       d.covariance = r.covariance;
       record.doubtful.push_back(d);
     }
+    // A light within decimetres of the lens may be a saturated disc wider than any blob.
+    for (const LightDetection& d : FindSaturatedDiscs(image)) record.doubtful.push_back(d);
     for (const LightDetection& d : frame.unexplained) {
       record.rejected.push_back({d.uv, d.radius_px, "not a light of the dock at the pose"});
     }

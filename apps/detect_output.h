@@ -38,8 +38,9 @@ struct FrameRecord {
   double residual_sigma_px = 0.0;  // the pose's residual per axis, a posteriori
   std::string symmetry, reason;    // without commas
   std::vector<RejectedLightCandidate> rejected;  // kept with the overlay only
-  // The candidates rejected on appearance alone (RejectedLightCandidate::overrulable), as
-  // detections with their covariance: a walk may find a light there (two_way_light_bridge.h).
+  // The candidates rejected on appearance alone (RejectedLightCandidate::overrulable) and the
+  // image's saturated discs (FindSaturatedDiscs), as detections with their covariance: a walk may
+  // find a light there (two_way_light_bridge.h).
   std::vector<LightDetection> doubtful;
 };
 

@@ -53,8 +53,11 @@ struct Footage {
 // partial_from on, only the dock file's first two lights are drawn (the rest out of the beam),
 // and the lamp; with whitened_second, only the second, as a wide white glow (a light a few
 // decimetres from the lens).
+// whitened_second: from partial_from on only the second light, within decimetres of the lens (a
+// wide saturated glow without colour); reflected: with a reflection merged into its plateau below
+// it (an egg-shaped saturated region).
 void MakeFootage(Footage* footage, int frames, int faded_light = -1, int partial_from = -1,
-                 bool whitened_second = false) {
+                 bool whitened_second = false, bool reflected = false) {
   DockModel dock = LoadDockModel(std::string(AUVDOCK_SOURCE_DIR) + "/data/docks/ring_8.yaml");
   dock.light_colour = "blue";
   SaveDockModel(dock, footage->dir / "dock.yaml");
@@ -90,7 +93,9 @@ void MakeFootage(Footage* footage, int frames, int faded_light = -1, int partial
         for (int v = 0; v < image.rows; ++v) {
           for (int u = 0; u < image.cols; ++u) {
             const double d2 = (u - uv.x()) * (u - uv.x()) + (v - uv.y()) * (v - uv.y());
-            const float level = static_cast<float>((d2 <= 35.0 * 35.0 ? 400.0 : 0.0) +
+            const double dv = v - uv.y() - 40.0;
+            const bool reflection = reflected && (u - uv.x()) * (u - uv.x()) + dv * dv <= 25.0 * 25.0;
+            const float level = static_cast<float>((d2 <= 35.0 * 35.0 || reflection ? 400.0 : 0.0) +
                                                    300.0 * std::exp(-d2 / (2.0 * 35.0 * 35.0)));
             image.at<cv::Vec3f>(v, u) += cv::Vec3f(level, level, level);
           }
@@ -282,8 +287,8 @@ TEST(DetectCli, AWhitenedCloseLightIsTakenWhereTheWalkPutsIt) {
   EXPECT_EQ(summary["labels"]["precision"], 1.0);
   ExpectEveryDetectionIdentifiedConsistently(footage, out, 8);
   const std::string frames = test::ReadTextFile(out + "/frames.csv");
-  EXPECT_NE(frames.find("1 candidates that the detector rejected on appearance lie where they put "
-                        "a light and are taken as it"),
+  EXPECT_NE(frames.find("1 candidates that the detector did not take (rejected on appearance, or a "
+                        "saturated disc) lie where they put a light and are taken as it"),
             std::string::npos)
       << frames;
   // With --bridge off nothing takes it: the rejected glow stays rejected.
@@ -293,6 +298,22 @@ TEST(DetectCli, AWhitenedCloseLightIsTakenWhereTheWalkPutsIt) {
   r = test::RunAuvdock(args);
   ASSERT_EQ(r.exit_status, 0) << r.err;
   EXPECT_NE(test::ReadTextFile(off + "/rejected.csv").find("wrong colour"), std::string::npos);
+}
+
+// The same light with a reflection merged into its saturated plateau below it: the region's
+// centroid is 8 px off; the light is its circle (saturated_disc.h).
+TEST(DetectCli, ACloseLightsReflectionDoesNotMoveIt) {
+  Footage footage;
+  std::filesystem::create_directories(footage.dir / "frames");
+  MakeFootage(&footage, 12, /*faded_light=*/-1, /*partial_from=*/8, /*whitened_second=*/true,
+              /*reflected=*/true);
+  const std::string out = footage.dir / "out";
+  const test::CommandResult r = test::RunAuvdock(DetectArgs(footage, out));
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const nlohmann::json summary = nlohmann::json::parse(test::ReadTextFile(out + "/summary.json"));
+  EXPECT_EQ(summary["bridged_frames"]["rejected_candidates_accepted"], 4);
+  EXPECT_EQ(summary["labels"]["precision"], 1.0);
+  ExpectEveryDetectionIdentifiedConsistently(footage, out, 8);
 }
 
 TEST(DetectCli, GravityResolvesAnUprightRing) {
