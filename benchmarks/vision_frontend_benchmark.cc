@@ -6,6 +6,9 @@
 //  * BM_DetectBlobFixedLevels: the same without the clip level and the neck cut (for the ratio);
 //  * BM_DetectBlobWithoutSurroundings: the same without the surroundings' colour test;
 //  * BM_OpenCvSimpleBlobDetector: OpenCV's blob detector on the same frame, side by side;
+//  * BM_FindSaturatedDiscs: `detect`'s search of the whole frame for saturated discs
+//    (saturated_disc.h), per frame besides the detector, on the same frame and on the down-looking
+//    camera's frame after touchdown (argument 1: one light's disc filling the image);
 //  * BM_ImageLevels: its reading of the image's noise and clip level (image_levels.h);
 //  * BM_PerFrame: the whole per-frame path of the paper's baseline (PaperBaselinePipeline::Process
 //    with dehazing on): dehaze + detect + match (hypothesise-and-verify, MatchRansac) + pose.
@@ -38,6 +41,7 @@
 #include "auvdock/vision/image_levels.h"
 #include "auvdock/vision/light_detector.h"
 #include "auvdock/vision/paper_baseline_pipeline.h"
+#include "auvdock/vision/saturated_disc.h"
 
 namespace auvdock {
 namespace {
@@ -105,6 +109,25 @@ void BM_DetectBlob(benchmark::State& state) {
   TimeDetection(BlobLightDetector(options), state);
 }
 BENCHMARK(BM_DetectBlob)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
+
+void BM_FindSaturatedDiscs(benchmark::State& state) {
+  const cv::Mat image = state.range(2) == 0
+                            ? RenderFrame(static_cast<int>(state.range(0)),
+                                          static_cast<int>(state.range(1)))
+                            : RenderFrame(static_cast<int>(state.range(0)),
+                                          static_cast<int>(state.range(1)), CameraRole::kMono, 39.5);
+  size_t found = 0;
+  for (auto _ : state) {
+    const std::vector<LightDetection> discs = FindSaturatedDiscs(image);
+    found = discs.size();
+    benchmark::DoNotOptimize(discs.data());
+  }
+  state.counters["discs"] = static_cast<double>(found);
+}
+BENCHMARK(BM_FindSaturatedDiscs)
+    ->Args({640, 512, 0})
+    ->Args({640, 512, 1})
+    ->Unit(benchmark::kMillisecond);
 
 // BM_DetectBlob without what adapts it to the exposure: no clip level, no neck cut (the detector
 // as it was before them), for the ratio of the two in one run.

@@ -87,13 +87,6 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
     stereo_shift->Apply(state.pose, state.velocity ? state.velocity : kZero3, stereo_pose);
   }
   const StageWeights weights = StageWeighting(options.stage_weighting).Compute(n_stereo, n_mono);
-  // The triangulation covariance is J (sigma^2 I) J^T: adding a variance to every pixel
-  // coordinate of the pair scales it.
-  double stereo_scale = 1.0;
-  if (stereo && options.correlated_pixel_variance > 0.0) {
-    const double sigma2 = rig.stereo_left->pixel_noise_px * rig.stereo_left->pixel_noise_px;
-    if (sigma2 > 0.0) stereo_scale = (sigma2 + options.correlated_pixel_variance) / sigma2;
-  }
   for (int i = 0; i < n_mono; ++i) {
     const MonoLightObservation& obs = frame.mono[i];
     const DockLight* light = rig.dock->FindLight(obs.light_id);
@@ -132,13 +125,23 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
       ++*n_skipped;
       continue;
     }
+    // The triangulation covariance is J (sigma^2 I) J^T: a covariance computed at one pixel
+    // sigma scales to another, and adding a variance to every pixel coordinate of the pair
+    // scales it too. The observation's is at its own sigma, the predicted one at the camera's.
+    const double camera_sigma = rig.stereo_left->pixel_noise_px;
+    const double sigma = obs.sigma_px > 0.0 ? obs.sigma_px : camera_sigma;
     Eigen::Matrix3d covariance = obs.covariance;
+    double at_sigma = sigma;
     if (T_B_D_predicted) {
       if (const auto predicted = PredictedStereoCovariance(rig, *T_B_D_predicted, light->p_D)) {
         covariance = *predicted;
+        at_sigma = camera_sigma;
       }
     }
-    const double scale = Factor(options.stereo_variance_factor, obs.light_id) * stereo_scale;
+    const double pixel_scale =
+        at_sigma > 0.0 ? (sigma * sigma + options.correlated_pixel_variance) / (at_sigma * at_sigma)
+                       : 1.0;
+    const double scale = Factor(options.stereo_variance_factor, obs.light_id) * pixel_scale;
     const ceres::ResidualBlockId id = AddOnState<StereoPointFactor, kStereoPointResidualSize>(
         problem,
         std::make_unique<StereoPointFactor>(obs.p_S, scale * covariance, rig.stereo_left->T_B_C,
@@ -146,7 +149,7 @@ std::vector<VisionResidual> AddVisionFactors(ceres::Problem* problem, const Visi
         *stereo_shift, WeightedHuber(options.huber_sigmas, weights.stereo), state);
     added.push_back({id, false, obs.light_id, weights.stereo, frame.t_ns + frame.stereo_dt_ns,
                      rig.stereo_left->name,
-                     std::sqrt(scale) * rig.stereo_left->pixel_noise_px});
+                     std::sqrt(scale) * at_sigma});
   }
   return added;
 }

@@ -25,6 +25,11 @@ std::map<int, int> IdentifiedLights(const CameraObservation& obs) {
   return index_of;
 }
 
+// The detector's own centroid sigma per coordinate, sqrt(trace / 2) (0 when it measures none).
+double OwnSigma(const LightDetection& detection) {
+  return std::sqrt(std::max(0.0, detection.covariance.trace()) / 2.0);
+}
+
 }  // namespace
 
 VisionFrame MakeVisionFrame(const BaselineFrame& frame, const CameraCalibration* left,
@@ -41,8 +46,7 @@ VisionFrame MakeVisionFrame(const BaselineFrame& frame, const CameraCalibration*
       obs.uv = detection.uv;
       // The detector's own centroid covariance when it measures one (never below the camera's
       // figure): a light cut by the border or smeared carries a wider one.
-      obs.sigma_px = std::max(mono->pixel_noise_px,
-                              std::sqrt(std::max(0.0, detection.covariance.trace()) / 2.0));
+      obs.sigma_px = std::max(mono->pixel_noise_px, OwnSigma(detection));
       out.mono.push_back(obs);
     }
   }
@@ -52,14 +56,19 @@ VisionFrame MakeVisionFrame(const BaselineFrame& frame, const CameraCalibration*
     for (const auto& [id, l] : in_left) {
       const auto r = in_right.find(id);
       if (r == in_right.end()) continue;
+      // As for mono: the detections' own centroid sigma where larger than the camera's, the
+      // larger of the two (the triangulation takes one sigma for both images).
+      const LightDetection& in_l = frame.left.detections[l];
+      const LightDetection& in_r = frame.right.detections[r->second];
+      const double sigma_px = std::max({left->pixel_noise_px, OwnSigma(in_l), OwnSigma(in_r)});
       const TriangulatedPoint point =
-          TriangulateLinear(frame.left.detections[l].uv, frame.right.detections[r->second].uv,
-                            *left, *right, left->pixel_noise_px);
+          TriangulateLinear(in_l.uv, in_r.uv, *left, *right, sigma_px);
       if (!point.ok) continue;
       StereoLightObservation obs;
       obs.light_id = id;
       obs.p_S = point.p_S;
       obs.covariance = point.covariance;
+      obs.sigma_px = sigma_px;
       out.stereo.push_back(obs);
     }
   }

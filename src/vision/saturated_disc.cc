@@ -16,14 +16,9 @@ cv::Mat SaturatedMask(const cv::Mat& image, int level) {
   cv::Mat mask;
   if (image.channels() == 1) {
     cv::compare(image, level, mask, cv::CMP_GE);
-    return mask;
+  } else {
+    cv::inRange(image, cv::Scalar(level, level, level), cv::Scalar(255, 255, 255), mask);
   }
-  cv::Mat least;
-  cv::Mat channels[3];
-  cv::split(image, channels);
-  cv::min(channels[0], channels[1], least);
-  cv::min(least, channels[2], least);
-  cv::compare(least, level, mask, cv::CMP_GE);
   return mask;
 }
 
@@ -187,9 +182,8 @@ std::optional<LightDetection> FindSaturatedDisc(const cv::Mat& image,
                           cv::Rect(0, 0, image.cols, image.rows);
   if (window.area() == 0) return std::nullopt;
   const cv::Mat mask = SaturatedMask(image(window), options.saturation_level);
-  cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
-  if (n < 2) return std::nullopt;
+  cv::Mat labels;
+  if (cv::connectedComponents(mask, labels, 8, CV_32S) < 2) return std::nullopt;
   // The region at or nearest the seed, within the search radius.
   const Eigen::Vector2d seed = seed_uv - Eigen::Vector2d(window.x, window.y);
   const int r = static_cast<int>(std::ceil(options.search_radius_px));
@@ -208,9 +202,9 @@ std::optional<LightDetection> FindSaturatedDisc(const cv::Mat& image,
     }
   }
   if (label == 0) return std::nullopt;
-  const cv::Rect box(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
-                     stats.at<int>(label, cv::CC_STAT_WIDTH),
-                     stats.at<int>(label, cv::CC_STAT_HEIGHT));
+  cv::Mat region;
+  cv::compare(labels, label, region, cv::CMP_EQ);
+  const cv::Rect box = cv::boundingRect(region);
   return MeasureDisc(labels, label, box, Eigen::Vector2d(window.x, window.y), options);
 }
 
@@ -218,17 +212,24 @@ std::vector<LightDetection> FindSaturatedDiscs(const cv::Mat& image,
                                                const SaturatedDiscOptions& options) {
   std::vector<LightDetection> discs;
   if (!UsableImage(image)) return discs;
+  // Most frames have no saturated region of a disc's size: the mask's count and its regions'
+  // outlines (one external contour per 8-connected region) say so before any labelling.
   const cv::Mat mask = SaturatedMask(image, options.saturation_level);
-  cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
   const double min_area = kPi * options.min_radius_px * options.min_radius_px;
-  for (int label = 1; label < n; ++label) {
-    if (stats.at<int>(label, cv::CC_STAT_AREA) < min_area) continue;
-    const cv::Rect box(stats.at<int>(label, cv::CC_STAT_LEFT),
-                       stats.at<int>(label, cv::CC_STAT_TOP),
-                       stats.at<int>(label, cv::CC_STAT_WIDTH),
-                       stats.at<int>(label, cv::CC_STAT_HEIGHT));
-    const auto disc = MeasureDisc(labels, label, box, Eigen::Vector2d::Zero(), options);
+  if (cv::countNonZero(mask) < min_area) return discs;
+  std::vector<std::vector<cv::Point>> outlines;
+  cv::findContours(mask.clone(), outlines, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  std::vector<std::pair<cv::Point, cv::Rect>> regions;  // a pixel of each large region, its box
+  for (const std::vector<cv::Point>& outline : outlines) {
+    if (cv::contourArea(outline) < 0.5 * min_area) continue;
+    regions.emplace_back(outline.front(), cv::boundingRect(outline));
+  }
+  if (regions.empty()) return discs;
+  cv::Mat labels;
+  cv::connectedComponents(mask, labels, 8, CV_32S);
+  for (const auto& [pixel, box] : regions) {
+    const auto disc =
+        MeasureDisc(labels, labels.at<int>(pixel), box, Eigen::Vector2d::Zero(), options);
     if (disc) discs.push_back(*disc);
   }
   return discs;

@@ -27,62 +27,100 @@ struct PoseProblem {
   ceres::Problem problem;
 };
 
-// A stereo light 9 m ahead, measured 0.4 m nearer than it is (a large depth error at that
-// range). With stereo_covariance_at_prediction the residual is whitened by the triangulation
-// covariance at the light's predicted position (from the pose block); without it, by the
-// measured point's, which is smaller (sigma_z ~ z^2) and so makes the same error look larger.
-TEST(VisionFactorsTest, StereoCovarianceIsTakenAtThePredictedLight) {
-  const Scenario scenario = test::DefaultScenario();
-  const Calibration calibration = MakeCalibration(scenario);
-  VisionRig rig;
-  rig.stereo_left = calibration.FindCameraByRole(CameraRole::kStereoLeft);
-  rig.stereo_right = calibration.FindCameraByRole(CameraRole::kStereoRight);
-  rig.dock = &scenario.dock;
-  ASSERT_NE(rig.stereo_left, nullptr);
-  ASSERT_NE(rig.stereo_right, nullptr);
-
-  // The body placed so that the dock's first light is 9 m in front of the left camera.
-  const DockLight& light = scenario.dock.lights.front();
-  const Pose3 T_S_D(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.1, -0.2, 9.0) - light.p_D);
-  const Pose3 T_D_B = (rig.stereo_left->T_B_C * T_S_D).Inverse();
-  double pose[kPoseSize];
-  PoseToBlock(T_D_B, pose);
-
-  const Eigen::Vector3d p_S_true = T_S_D * light.p_D;
-  const Eigen::Vector3d p_S_measured = p_S_true * (8.6 / p_S_true.z());
-  const auto project = [&](const CameraCalibration& c, const Eigen::Vector3d& p_S) {
-    const Eigen::Vector3d p_B = rig.stereo_left->T_B_C * p_S;
-    return *c.intrinsics.Project(c.T_B_C.Inverse() * p_B);
-  };
-  const double sigma = rig.stereo_left->pixel_noise_px;
-  const Eigen::Matrix3d at_truth =
-      TriangulateLinear(project(*rig.stereo_left, p_S_true), project(*rig.stereo_right, p_S_true),
-                        *rig.stereo_left, *rig.stereo_right, sigma)
-          .covariance;
-  const Eigen::Matrix3d at_measured =
-      TriangulateLinear(project(*rig.stereo_left, p_S_measured),
-                        project(*rig.stereo_right, p_S_measured), *rig.stereo_left,
-                        *rig.stereo_right, sigma)
-          .covariance;
-  ASSERT_LT(at_measured(2, 2), at_truth(2, 2));
-
-  VisionFrame frame;
-  frame.stereo.push_back({light.id, p_S_measured, at_measured});
-  const Eigen::Vector3d e = p_S_measured - p_S_true;
-  for (const bool at_prediction : {true, false}) {
+// The default rig's stereo pair with the body placed so that the dock's first light is 9 m in
+// front of the left camera, measured 0.4 m nearer than it is (a large depth error at that range).
+struct StereoLightAhead {
+  StereoLightAhead() {
+    rig.stereo_left = calibration.FindCameraByRole(CameraRole::kStereoLeft);
+    rig.stereo_right = calibration.FindCameraByRole(CameraRole::kStereoRight);
+    rig.dock = &scenario.dock;
+    const Pose3 T_D_B = (rig.stereo_left->T_B_C * T_S_D).Inverse();
+    PoseToBlock(T_D_B, pose);
+  }
+  // The triangulation covariance of p_S's projections at pixel sigma `sigma`.
+  Eigen::Matrix3d CovarianceAt(const Eigen::Vector3d& p_S, double sigma) const {
+    const auto project = [&](const CameraCalibration& c) {
+      const Eigen::Vector3d p_B = rig.stereo_left->T_B_C * p_S;
+      return *c.intrinsics.Project(c.T_B_C.Inverse() * p_B);
+    };
+    return TriangulateLinear(project(*rig.stereo_left), project(*rig.stereo_right),
+                             *rig.stereo_left, *rig.stereo_right, sigma)
+        .covariance;
+  }
+  // 2 x the cost of the frame's one stereo residual (its squared Mahalanobis distance).
+  double SquaredDistance(const VisionFrame& frame, const VisionFactorOptions& options) {
     PoseProblem problem(pose);
-    VisionFactorOptions options;
-    options.use_mono = false;
-    options.stereo_covariance_at_prediction = at_prediction;
     int skipped = 0;
     const std::vector<VisionResidual> residuals =
         AddVisionFactors(&problem.problem, frame, rig, options, StateBlocks(pose), &skipped);
-    ASSERT_EQ(residuals.size(), 1u);
+    EXPECT_EQ(residuals.size(), 1u);
+    if (residuals.size() != 1u) return 0.0;
     double cost = 0.0;
     problem.problem.EvaluateResidualBlock(residuals[0].id, false, &cost, nullptr, nullptr);
+    return 2.0 * cost;
+  }
+  const Scenario scenario = test::DefaultScenario();
+  const Calibration calibration = MakeCalibration(scenario);
+  VisionRig rig;
+  const DockLight& light = scenario.dock.lights.front();
+  const Pose3 T_S_D{Eigen::Quaterniond::Identity(),
+                    Eigen::Vector3d(0.1, -0.2, 9.0) - scenario.dock.lights.front().p_D};
+  const Eigen::Vector3d p_S_true = T_S_D * light.p_D;
+  const Eigen::Vector3d p_S_measured = p_S_true * (8.6 / p_S_true.z());
+  double pose[kPoseSize];
+};
+
+// With stereo_covariance_at_prediction the residual is whitened by the triangulation
+// covariance at the light's predicted position (from the pose block); without it, by the
+// measured point's, which is smaller (sigma_z ~ z^2) and so makes the same error look larger.
+TEST(VisionFactorsTest, StereoCovarianceIsTakenAtThePredictedLight) {
+  StereoLightAhead ahead;
+  ASSERT_NE(ahead.rig.stereo_left, nullptr);
+  ASSERT_NE(ahead.rig.stereo_right, nullptr);
+  const double sigma = ahead.rig.stereo_left->pixel_noise_px;
+  const Eigen::Matrix3d at_truth = ahead.CovarianceAt(ahead.p_S_true, sigma);
+  const Eigen::Matrix3d at_measured = ahead.CovarianceAt(ahead.p_S_measured, sigma);
+  ASSERT_LT(at_measured(2, 2), at_truth(2, 2));
+
+  VisionFrame frame;
+  frame.stereo.push_back({ahead.light.id, ahead.p_S_measured, at_measured});
+  const Eigen::Vector3d e = ahead.p_S_measured - ahead.p_S_true;
+  for (const bool at_prediction : {true, false}) {
+    VisionFactorOptions options;
+    options.use_mono = false;
+    options.stereo_covariance_at_prediction = at_prediction;
     const Eigen::Matrix3d& expected_covariance = at_prediction ? at_truth : at_measured;
-    EXPECT_NEAR(2.0 * cost, e.dot(expected_covariance.ldlt().solve(e)),
-                1e-6 * (2.0 * cost)) << at_prediction;
+    const double d2 = ahead.SquaredDistance(frame, options);
+    EXPECT_NEAR(d2, e.dot(expected_covariance.ldlt().solve(e)), 1e-6 * d2) << at_prediction;
+  }
+}
+
+// A pair whose detections carry a centroid sigma 3 times the camera's (a saturated light) is
+// whitened at that sigma, the predicted covariance scaled to it, and the correlated variance
+// added to it: covariance x (s^2 + c) / s_computed^2.
+TEST(VisionFactorsTest, StereoCovarianceIsTakenAtThePairsOwnPixelSigma) {
+  StereoLightAhead ahead;
+  ASSERT_NE(ahead.rig.stereo_left, nullptr);
+  const double camera_sigma = ahead.rig.stereo_left->pixel_noise_px;
+  const double own_sigma = 3.0 * camera_sigma;
+  const double correlated = 0.04;
+  VisionFrame frame;
+  frame.stereo.push_back({ahead.light.id, ahead.p_S_measured,
+                          ahead.CovarianceAt(ahead.p_S_measured, own_sigma), own_sigma});
+  const Eigen::Vector3d e = ahead.p_S_measured - ahead.p_S_true;
+  const double factor = (own_sigma * own_sigma + correlated);
+  for (const bool at_prediction : {true, false}) {
+    VisionFactorOptions options;
+    options.use_mono = false;
+    options.stereo_covariance_at_prediction = at_prediction;
+    options.correlated_pixel_variance = correlated;
+    const Eigen::Matrix3d expected =
+        at_prediction ? ahead.CovarianceAt(ahead.p_S_true, camera_sigma) * factor /
+                            (camera_sigma * camera_sigma)
+                      : ahead.CovarianceAt(ahead.p_S_measured, own_sigma) * factor /
+                            (own_sigma * own_sigma);
+    const double d2 = ahead.SquaredDistance(frame, options);
+    EXPECT_NEAR(d2, e.dot(expected.ldlt().solve(e)), 1e-6 * d2) << at_prediction;
   }
 }
 

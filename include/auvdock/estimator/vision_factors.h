@@ -5,7 +5,8 @@
 //   mono   MonoReprojectionFactor (2): raw pixel against the projected dock light, whitened by
 //          the detection's pixel sigma;
 //   stereo StereoPointFactor (3): triangulated p_S against the dock light, whitened by the
-//          triangulation covariance -- by default evaluated at the light's position predicted
+//          triangulation covariance at the pair's pixel sigma (StereoLightObservation::
+//          sigma_px) -- by default evaluated at the light's position predicted
 //          from the pose block's value when the factor is added (the IMU prediction in the
 //          sliding window, the warm start in the batch smoother), not at the measured point:
 //          the first-order covariance grows as z^4 (depth sigma ~ z^2 / (f b)), so evaluated at
@@ -16,9 +17,10 @@
 //          the sliding window's from 3.35 to 2.8. The measured-point covariance is used when the
 //          light does not project into both cameras or the option is off.
 // correlated_pixel_variance (px^2, default 0) is added to the white variance of every pixel
-// coordinate: to sigma_px^2 of a mono pixel, and to the stereo pair's pixel_noise_px^2 in its
+// coordinate: to sigma_px^2 of a mono pixel, and to the stereo pair's sigma_px^2 in its
 // triangulation covariance, which is linear in the (i.i.d.) pixel variance and so is scaled by
-// (sigma_px^2 + correlated_pixel_variance) / sigma_px^2. The batch smoother uses it for the
+// (sigma_px^2 + correlated_pixel_variance) / s^2, s the sigma it was computed at (the pair's, or
+// the camera's pixel_noise_px for the predicted one). The batch smoother uses it for the
 // time-correlated part of the detection errors (estimator/batch_smoother.h); the sliding window
 // leaves it at 0.
 // Each gets a Huber loss (threshold huber_sigmas on the whitened norm; none when +infinity)

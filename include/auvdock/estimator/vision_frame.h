@@ -3,7 +3,9 @@
 //
 //   mono:   lights identified in the mono camera's raw (distorted) image, pixels;
 //   stereo: lights identified in both stereo images and triangulated, p_S in S = the
-//           stereo-left camera frame (OpenCV axes), with the 3 x 3 covariance from pixel noise.
+//           stereo-left camera frame (OpenCV axes), with the 3 x 3 covariance from the pair's
+//           pixel sigma (sigma_px: the larger of the camera's pixel noise and the two
+//           detections' own centroid sigmas; 0 where unknown: the camera's pixel noise).
 // T_D_B_initial is a per-frame pose (the paper's baseline) used only to initialise or re-seed
 // the estimator; it never enters the cost.
 //
@@ -33,7 +35,8 @@ struct MonoLightObservation {
 struct StereoLightObservation {
   int light_id = -1;
   Eigen::Vector3d p_S = Eigen::Vector3d::Zero();         // m
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // of p_S, m^2
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // of p_S, m^2, at sigma_px
+  double sigma_px = 0.0;  // 1-sigma per pixel coordinate of both images; 0: the camera's
 };
 
 struct VisionFrame {
