@@ -19,8 +19,8 @@
 // neighbouring frames' pose"), and a close light's candidate rejected for its colour alone
 // (RejectedLightCandidate::overrulable: a light within decimetres of the lens whitens its glow),
 // or a saturated disc wider than any blob (saturated_disc.h), where the walk puts a light becomes
-// that light's detection; their reason in frames.csv says so,
-// and summary.json counts them (bridged_frames.rejected_candidates_accepted). Writes
+// that light's detection; their reason in frames.csv says so, and summary.json counts them
+// (bridged_frames.rejected_candidates_accepted). Writes
 // (detect_output.h), flushed frame by frame (a stopped run keeps every frame written before the stop, as it was
 // before the end), and written anew from memory when the end changed anything (each file to a
 // temporary, renamed over the old one; the overlays of the bridged frames are drawn again):
@@ -131,7 +131,8 @@ struct WalkRevision {
 // its pose and identities; a bridged one gets the walk's identities, and what the walk judged no
 // light of the dock moves to its rejected candidates (unless keep_unexplained), and a candidate
 // rejected on appearance alone, or a saturated disc, where the walk put a light
-// (FewLightTracker's doubtful candidates) becomes that light's detection. Each says so in its reason.
+// (FewLightTracker's doubtful candidates) becomes that light's detection. Each says so in its
+// reason.
 WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep_unexplained,
                               std::vector<FrameRecord>* records,
                               std::map<std::string, int>* rejected_reasons) {

@@ -111,11 +111,11 @@ void BM_DetectBlob(benchmark::State& state) {
 BENCHMARK(BM_DetectBlob)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
 
 void BM_FindSaturatedDiscs(benchmark::State& state) {
-  const cv::Mat image = state.range(2) == 0
-                            ? RenderFrame(static_cast<int>(state.range(0)),
-                                          static_cast<int>(state.range(1)))
-                            : RenderFrame(static_cast<int>(state.range(0)),
-                                          static_cast<int>(state.range(1)), CameraRole::kMono, 39.5);
+  const cv::Mat image =
+      state.range(2) == 0
+          ? RenderFrame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)))
+          : RenderFrame(static_cast<int>(state.range(0)), static_cast<int>(state.range(1)),
+                        CameraRole::kMono, 39.5);
   size_t found = 0;
   for (auto _ : state) {
     const std::vector<LightDetection> discs = FindSaturatedDiscs(image);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+#include <vector>
 
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
@@ -35,9 +37,8 @@ std::optional<Circle> CircleThrough(const Eigen::Vector2d& a, const Eigen::Vecto
   if (std::fabs(d) < 1e-9 * ab.squaredNorm() * ac.squaredNorm() || std::fabs(d) < 1e-12) {
     return std::nullopt;
   }
-  const Eigen::Vector2d o(
-      (ac.y() * ab.squaredNorm() - ab.y() * ac.squaredNorm()) / d,
-      (ab.x() * ac.squaredNorm() - ac.x() * ab.squaredNorm()) / d);
+  const Eigen::Vector2d o((ac.y() * ab.squaredNorm() - ab.y() * ac.squaredNorm()) / d,
+                          (ab.x() * ac.squaredNorm() - ac.x() * ab.squaredNorm()) / d);
   return Circle{a + o, o.norm()};
 }
 
@@ -45,11 +46,24 @@ double Tolerance(const Circle& circle, const SaturatedDiscOptions& options) {
   return std::max(1.0, options.arc_tolerance_fraction * circle.radius);
 }
 
+bool OnCircle(const Eigen::Vector2d& p, const Circle& circle, double tolerance) {
+  return std::fabs((p - circle.centre).norm() - circle.radius) <= tolerance;
+}
+
+size_t CountInliers(const std::vector<Eigen::Vector2d>& outline, const Circle& circle,
+                    const SaturatedDiscOptions& options) {
+  const double tolerance = Tolerance(circle, options);
+  return static_cast<size_t>(std::count_if(outline.begin(), outline.end(), [&](const auto& p) {
+    return OnCircle(p, circle, tolerance);
+  }));
+}
+
 std::vector<Eigen::Vector2d> Inliers(const std::vector<Eigen::Vector2d>& outline,
-                                     const Circle& circle, double tolerance) {
+                                     const Circle& circle, const SaturatedDiscOptions& options) {
+  const double tolerance = Tolerance(circle, options);
   std::vector<Eigen::Vector2d> inliers;
   for (const Eigen::Vector2d& p : outline) {
-    if (std::fabs((p - circle.centre).norm() - circle.radius) <= tolerance) inliers.push_back(p);
+    if (OnCircle(p, circle, tolerance)) inliers.push_back(p);
   }
   return inliers;
 }
@@ -76,9 +90,10 @@ Circle RefineCircle(const std::vector<Eigen::Vector2d>& points, Circle circle) {
   return circle;
 }
 
-// The circle that the most outline pixels lie on (see the header), and how many do.
+// The circle that the most outline pixels lie on (see the header), of radius at most
+// max_radius.
 std::optional<Circle> ConsensusCircle(const std::vector<Eigen::Vector2d>& outline,
-                                      const SaturatedDiscOptions& options, size_t max_radius) {
+                                      const SaturatedDiscOptions& options, double max_radius) {
   const size_t n = outline.size();
   if (n < 12) return std::nullopt;
   std::optional<Circle> best;
@@ -89,7 +104,7 @@ std::optional<Circle> ConsensusCircle(const std::vector<Eigen::Vector2d>& outlin
       const auto circle =
           CircleThrough(outline[i], outline[(i + gap) % n], outline[(i + 2 * gap) % n]);
       if (!circle || circle->radius > max_radius) continue;
-      const size_t support = Inliers(outline, *circle, Tolerance(*circle, options)).size();
+      const size_t support = CountInliers(outline, *circle, options);
       if (support > best_support) {
         best_support = support;
         best = circle;
@@ -99,8 +114,7 @@ std::optional<Circle> ConsensusCircle(const std::vector<Eigen::Vector2d>& outlin
   if (!best) return std::nullopt;
   Circle circle = *best;
   for (int pass = 0; pass < 2; ++pass) {
-    const std::vector<Eigen::Vector2d> inliers =
-        Inliers(outline, circle, Tolerance(circle, options));
+    const std::vector<Eigen::Vector2d> inliers = Inliers(outline, circle, options);
     if (inliers.size() < 3) return std::nullopt;
     circle = RefineCircle(inliers, circle);
   }
@@ -128,17 +142,15 @@ std::optional<LightDetection> MeasureDisc(const cv::Mat& labels, int label, cons
   std::vector<std::vector<cv::Point>> contours;
   cv::findContours(framed, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
   if (contours.empty()) return std::nullopt;
-  const auto longest = std::max_element(
-      contours.begin(), contours.end(),
-      [](const auto& a, const auto& b) { return a.size() < b.size(); });
+  const auto longest =
+      std::max_element(contours.begin(), contours.end(),
+                       [](const auto& a, const auto& b) { return a.size() < b.size(); });
   std::vector<Eigen::Vector2d> outline;
   outline.reserve(longest->size());
   for (const cv::Point& p : *longest) outline.emplace_back(p.x - 1, p.y - 1);
-  const auto circle =
-      ConsensusCircle(outline, options, static_cast<size_t>(std::max(box.width, box.height)));
+  const auto circle = ConsensusCircle(outline, options, std::max(box.width, box.height));
   if (!circle) return std::nullopt;
-  const double support =
-      static_cast<double>(Inliers(outline, *circle, Tolerance(*circle, options)).size());
+  const double support = static_cast<double>(CountInliers(outline, *circle, options));
   if (support < options.min_arc_fraction * 2.0 * kPi * circle->radius) return std::nullopt;
   // Fill and overreach: the region's pixels within and beyond the disc of radius R + 1/2.
   const double radius = circle->radius + 0.5;
@@ -151,8 +163,7 @@ std::optional<LightDetection> MeasureDisc(const cv::Mat& labels, int label, cons
     }
   }
   const double disc_area = kPi * radius * radius;
-  if (inside < options.min_fill * disc_area ||
-      outside > options.max_outside_fraction * disc_area) {
+  if (inside < options.min_fill * disc_area || outside > options.max_outside_fraction * disc_area) {
     return std::nullopt;
   }
   LightDetection d;

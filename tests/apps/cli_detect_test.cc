@@ -94,7 +94,8 @@ void MakeFootage(Footage* footage, int frames, int faded_light = -1, int partial
           for (int u = 0; u < image.cols; ++u) {
             const double d2 = (u - uv.x()) * (u - uv.x()) + (v - uv.y()) * (v - uv.y());
             const double dv = v - uv.y() - 40.0;
-            const bool reflection = reflected && (u - uv.x()) * (u - uv.x()) + dv * dv <= 25.0 * 25.0;
+            const bool reflection =
+                reflected && (u - uv.x()) * (u - uv.x()) + dv * dv <= 25.0 * 25.0;
             const float level = static_cast<float>((d2 <= 35.0 * 35.0 || reflection ? 400.0 : 0.0) +
                                                    300.0 * std::exp(-d2 / (2.0 * 35.0 * 35.0)));
             image.at<cv::Vec3f>(v, u) += cv::Vec3f(level, level, level);

@@ -42,8 +42,8 @@ TEST(SaturatedDiscTest, FindsTheCentreOfALargeSaturatedDisc) {
 
 TEST(SaturatedDiscTest, RefusesWhatIsNotOneWholeRoundDisc) {
   // Cut by the image border.
-  EXPECT_FALSE(FindSaturatedDisc(LightImage({{Eigen::Vector2d(30, 240), 50.0}}),
-                                 Eigen::Vector2d(30, 240)));
+  EXPECT_FALSE(
+      FindSaturatedDisc(LightImage({{Eigen::Vector2d(30, 240), 50.0}}), Eigen::Vector2d(30, 240)));
   // Two lights merged into one saturated region.
   const cv::Mat merged =
       LightImage({{Eigen::Vector2d(280, 240), 40.0}, {Eigen::Vector2d(345, 240), 40.0}});
@@ -52,8 +52,8 @@ TEST(SaturatedDiscTest, RefusesWhatIsNotOneWholeRoundDisc) {
   EXPECT_FALSE(FindSaturatedDisc(LightImage({{Eigen::Vector2d(300, 240), 40.0}}),
                                  Eigen::Vector2d(400, 400)));
   // A small core: the blob detector's.
-  EXPECT_FALSE(FindSaturatedDisc(LightImage({{Eigen::Vector2d(300, 240), 4.0}}),
-                                 Eigen::Vector2d(300, 240)));
+  EXPECT_FALSE(
+      FindSaturatedDisc(LightImage({{Eigen::Vector2d(300, 240), 4.0}}), Eigen::Vector2d(300, 240)));
   // A ring (a lit rim), not a filled disc.
   cv::Mat ring(512, 640, CV_8UC3, cv::Scalar(40, 60, 20));
   cv::circle(ring, cv::Point(300, 240), 60, cv::Scalar(255, 255, 255), 12);
@@ -70,8 +70,10 @@ TEST(SaturatedDiscTest, TheLightsCircleNotTheCentroidOfAnEggShapedPlateau) {
   const Eigen::Vector2d light(320.4, 230.6);
   const Eigen::Vector2d reflection = light + Eigen::Vector2d(0.0, 70.0);
   cv::Mat image = LightImage({{light, 60.0}});
-  cv::circle(image, cv::Point(static_cast<int>(reflection.x() * 16), static_cast<int>(reflection.y() * 16)),
-             45 * 16, cv::Scalar(255, 255, 255), cv::FILLED, cv::LINE_AA, 4);
+  cv::circle(
+      image,
+      cv::Point(static_cast<int>(reflection.x() * 16), static_cast<int>(reflection.y() * 16)),
+      45 * 16, cv::Scalar(255, 255, 255), cv::FILLED, cv::LINE_AA, 4);
   cv::Mat least;
   cv::cvtColor(image, least, cv::COLOR_BGR2GRAY);
   const cv::Moments m = cv::moments(least >= 250, true);
@@ -88,7 +90,7 @@ TEST(SaturatedDiscTest, FindsEveryWholeDiscOfAnImage) {
                               {Eigen::Vector2d(420.6, 260.1), 50.0},
                               {Eigen::Vector2d(20.0, 480.0), 40.0}});  // cut by the border
   cv::rectangle(image, cv::Rect(300, 20, 200, 20), cv::Scalar(255, 255, 255), cv::FILLED);  // a bar
-  cv::circle(image, cv::Point(560, 420), 40, cv::Scalar(255, 255, 255), 8);  // a ring
+  cv::circle(image, cv::Point(560, 420), 40, cv::Scalar(255, 255, 255), 8);        // a ring
   cv::circle(image, cv::Point(60, 60), 3, cv::Scalar(255, 255, 255), cv::FILLED);  // a small core
   std::vector<LightDetection> discs = FindSaturatedDiscs(image);
   ASSERT_EQ(discs.size(), 2u);

@@ -47,8 +47,8 @@ namespace auvdock {
 
 struct SaturatedDiscOptions {
   int saturation_level = 250;
-  double search_radius_px = 8.0;   // FindSaturatedDisc: how far from the seed the region may lie
-  double window_radius_px = 300.0; // FindSaturatedDisc: the searched window around the seed
+  double search_radius_px = 8.0;    // FindSaturatedDisc: how far from the seed the region may lie
+  double window_radius_px = 300.0;  // FindSaturatedDisc: the searched window around the seed
   double min_radius_px = 6.0;
   double arc_tolerance_fraction = 0.03;
   double min_arc_fraction = 0.5;
