@@ -42,6 +42,7 @@ std::optional<Circle> CircleThrough(const Eigen::Vector2d& a, const Eigen::Vecto
   return Circle{a + o, o.norm()};
 }
 
+// How far from the circle an outline pixel may lie and still support it (the acceptance).
 double Tolerance(const Circle& circle, const SaturatedDiscOptions& options) {
   return std::max(1.0, options.arc_tolerance_fraction * circle.radius);
 }
@@ -51,16 +52,14 @@ bool OnCircle(const Eigen::Vector2d& p, const Circle& circle, double tolerance) 
 }
 
 size_t CountInliers(const std::vector<Eigen::Vector2d>& outline, const Circle& circle,
-                    const SaturatedDiscOptions& options) {
-  const double tolerance = Tolerance(circle, options);
+                    double tolerance) {
   return static_cast<size_t>(std::count_if(outline.begin(), outline.end(), [&](const auto& p) {
     return OnCircle(p, circle, tolerance);
   }));
 }
 
 std::vector<Eigen::Vector2d> Inliers(const std::vector<Eigen::Vector2d>& outline,
-                                     const Circle& circle, const SaturatedDiscOptions& options) {
-  const double tolerance = Tolerance(circle, options);
+                                     const Circle& circle, double tolerance) {
   std::vector<Eigen::Vector2d> inliers;
   for (const Eigen::Vector2d& p : outline) {
     if (OnCircle(p, circle, tolerance)) inliers.push_back(p);
@@ -104,7 +103,7 @@ std::optional<Circle> ConsensusCircle(const std::vector<Eigen::Vector2d>& outlin
       const auto circle =
           CircleThrough(outline[i], outline[(i + gap) % n], outline[(i + 2 * gap) % n]);
       if (!circle || circle->radius > max_radius) continue;
-      const size_t support = CountInliers(outline, *circle, options);
+      const size_t support = CountInliers(outline, *circle, options.fit_tolerance_px);
       if (support > best_support) {
         best_support = support;
         best = circle;
@@ -114,7 +113,8 @@ std::optional<Circle> ConsensusCircle(const std::vector<Eigen::Vector2d>& outlin
   if (!best) return std::nullopt;
   Circle circle = *best;
   for (int pass = 0; pass < 2; ++pass) {
-    const std::vector<Eigen::Vector2d> inliers = Inliers(outline, circle, options);
+    const std::vector<Eigen::Vector2d> inliers =
+        Inliers(outline, circle, options.fit_tolerance_px);
     if (inliers.size() < 3) return std::nullopt;
     circle = RefineCircle(inliers, circle);
   }
@@ -150,7 +150,8 @@ std::optional<LightDetection> MeasureDisc(const cv::Mat& labels, int label, cons
   for (const cv::Point& p : *longest) outline.emplace_back(p.x - 1, p.y - 1);
   const auto circle = ConsensusCircle(outline, options, std::max(box.width, box.height));
   if (!circle) return std::nullopt;
-  const double support = static_cast<double>(CountInliers(outline, *circle, options));
+  const double support =
+      static_cast<double>(CountInliers(outline, *circle, Tolerance(*circle, options)));
   if (support < options.min_arc_fraction * 2.0 * kPi * circle->radius) return std::nullopt;
   // Fill and overreach: the region's pixels within and beyond the disc of radius R + 1/2.
   const double radius = circle->radius + 0.5;

@@ -10,8 +10,9 @@
 //   - its equivalent radius sqrt(area / pi) is at least min_radius_px (smaller cores are the
 //     blob detector's),
 //   - a circle fits its outline: the circle (c, R) that the most outline pixels lie on, within
-//     max(1 px, arc_tolerance_fraction R) of it, is supported by outline pixels over at least
-//     min_arc_fraction of its circumference (one outline pixel a pixel of arc),
+//     fit_tolerance_px of it, is supported by outline pixels within max(1 px,
+//     arc_tolerance_fraction R) of it over at least min_arc_fraction of its circumference (one
+//     outline pixel a pixel of arc),
 //   - the region fills that circle (at least min_fill of the pixels within R + 1/2 of c) and does
 //     not reach far beyond it (the pixels outside at most max_outside_fraction of the circle's).
 // The circle, not the region's centroid, is the light: a reflection or a second glow merged into
@@ -24,8 +25,13 @@
 // Circle fit: candidate circles through three outline pixels a third, a quarter and a sixth of the
 // outline apart, from starting pixels spread over the outline (deterministic); the best one's
 // inliers refined by Gauss-Newton on the geometric distance |p_i - c| - R, twice (inliers again
-// after the first). Outline pixel centres lie half a pixel inside the region's edge, so the disc's
-// radius is R + 1/2.
+// after the first). The fit's tolerance is a pixel (the outline's quantisation), so that it
+// settles on the arc that is most exactly a circle: a reflection's glow pushes the outline out
+// smoothly over half the disc or more, and a tolerance that grows with the disc takes that part
+// in (on the renders' discs of radius >= 40 px under the landed camera, 2-3 px from the light
+// instead of 4-6 px). The wider acceptance tolerance is for a real beam's outline, which is not
+// a perfect circle. Outline pixel centres lie half a pixel inside the region's edge, so the
+// disc's radius is R + 1/2.
 //
 // The detection is the circle's centre, that radius and an isotropic centroid covariance
 // (centroid_sigma_fraction * radius + centroid_sigma_floor_px)^2: a disc's outline is shaped by
@@ -50,6 +56,7 @@ struct SaturatedDiscOptions {
   double search_radius_px = 8.0;    // FindSaturatedDisc: how far from the seed the region may lie
   double window_radius_px = 300.0;  // FindSaturatedDisc: the searched window around the seed
   double min_radius_px = 6.0;
+  double fit_tolerance_px = 1.0;
   double arc_tolerance_fraction = 0.03;
   double min_arc_fraction = 0.5;
   double min_fill = 0.9;
