@@ -143,10 +143,16 @@ WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep
     const BridgedFrame& walked = frames[k];
     if (walked.refuted) {
       ++revision.refuted;
-      record.reason = "refuted: its tracked pose (" + std::to_string(walked.identified) +
-                      " lights) is refuted by the longer run of poses from frame " +
-                      std::to_string((*records)[walked.refuted_by].index) +
-                      ", whose walk labels more of its detections";
+      const std::string from = std::to_string((*records)[walked.refuted_by].index);
+      record.reason =
+          walked.contradicted > 0
+              ? "refuted: its lone pose (" + std::to_string(walked.identified) + " lights) takes " +
+                    std::to_string(walked.contradicted) +
+                    " detections for lights that the run of poses from frame " + from +
+                    " judges no light of the dock"
+              : "refuted: its tracked pose (" + std::to_string(walked.identified) +
+                    " lights) is refuted by the longer run of poses from frame " + from +
+                    ", whose walk labels more of its detections";
       record.status = "refuted";
       record.tracked = false;
       record.T_C_D.reset();
@@ -367,6 +373,7 @@ void RunDetect(const DetectOptions& options) {
       frames[k].residual_sigma_px = records[k].residual_sigma_px;
       frames[k].tracked = records[k].tracked;
       frames[k].doubtful = records[k].doubtful;
+      frames[k].own_light_ids = records[k].light_ids;
       for (const int id : records[k].light_ids) frames[k].identified += id >= 0;
     }
     TwoWayLightBridgeOptions bridge_options;

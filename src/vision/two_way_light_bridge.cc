@@ -13,6 +13,7 @@ struct Chain {
   std::vector<int> frames;  // posed, in time order
   bool refuted = false;
   int refuted_by = -1;
+  int contradicted = 0;  // refuted as a lone pose for this many lights judged none
 };
 
 class Bridge {
@@ -59,12 +60,23 @@ class Bridge {
       for (int k : chain.frames) {
         frames_[k].refuted = true;
         frames_[k].refuted_by = chain.refuted_by;
+        frames_[k].contradicted = chain.contradicted;
       }
     }
   }
 
  private:
   bool Stands(int k) const { return chain_of_[k] >= 0 && !chains_[chain_of_[k]].refuted; }
+
+  // The frame's detections that its own pose took for lights and the walk's step judges no
+  // light of the dock.
+  static int Contradicted(const BridgedFrame& frame, const FewLightStep& step) {
+    int contradicted = 0;
+    for (size_t i = 0; i < frame.own_light_ids.size() && i < step.unexplained.size(); ++i) {
+      contradicted += frame.own_light_ids[i] >= 0 && step.unexplained[i];
+    }
+    return contradicted;
+  }
 
   // Walks from chain c's end (step +1: forward from its last frame; -1: backward from its first)
   // while frames without a standing pose follow; a chain too short to start a walk is walked
@@ -102,7 +114,16 @@ class Bridge {
           chain.refuted = true;
           chain.refuted_by = end;
         } else if (static_cast<int>(chain.frames.size()) < options_.tracker.min_start_poses) {
-          continue;  // a lone pose among frames without one: walked through
+          // A lone pose among frames without one: walked through, and refuted when the walk
+          // finds what it took for lights to be none.
+          const int contradicted = Contradicted(frame, *result);
+          if (!record && options_.lone_refute_contradicted > 0 &&
+              contradicted >= options_.lone_refute_contradicted) {
+            chain.refuted = true;
+            chain.refuted_by = end;
+            chain.contradicted = contradicted;
+          }
+          continue;
         } else {
           return;
         }

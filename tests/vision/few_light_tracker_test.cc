@@ -352,5 +352,59 @@ TEST_F(FewLightTrackerTest, ALongerChainRefutesAWrongTrackedChainBesideIt) {
   }
 }
 
+// A lone pose from scratch among frames with too few lights for one (frame 13), which takes two
+// specks for lights 3 and 4, 0.5 m off: the walk from the posed run before it judges both specks
+// no light of the dock, so the lone pose is refuted, and its frame bridged. The same frame with
+// its true pose stands, and so does the wrong one with lone_refute_contradicted 0.
+TEST_F(FewLightTrackerTest, ALonePoseThatTakesWhatTheWalkJudgesNoLightForLightsIsRefuted) {
+  std::vector<BridgedFrame> frames(18);
+  for (int k = 0; k < 18; ++k) {
+    BridgedFrame& f = frames[k];
+    if (k < 10) {
+      f.detections = AllLights(Truth(k));
+      f.own_light_ids = {0, 1, 2, 3, 4, 5};
+      f.identified = 6;
+      f.T_C_D = Measured(Truth(k));
+      f.covariance_local = PnpCovariance();
+      f.tracked = k > 0;
+      continue;
+    }
+    f.detections = TwoLightsAndASpeck(Truth(k));
+    if (k == 13) {
+      f.detections.push_back(Detection(Project(Truth(k), 0) + Eigen::Vector2d(90.0, -60.0)));
+      f.own_light_ids = {0, 1, 3, 4};
+      f.identified = 4;
+      f.T_C_D = Pose3(Truth(k).q, Truth(k).p + Eigen::Vector3d(0.5, 0.0, 0.0));
+      f.covariance_local = PnpCovariance();
+    }
+  }
+  TwoWayLightBridgeOptions options;
+  std::vector<BridgedFrame> refuted = frames;
+  BridgeFramesWithoutPose(camera_, dock_, 0.1, options, &refuted);
+  EXPECT_TRUE(refuted[13].refuted);
+  EXPECT_EQ(refuted[13].refuted_by, 9);
+  EXPECT_EQ(refuted[13].contradicted, 2);
+  ASSERT_TRUE(refuted[13].bridged);
+  EXPECT_EQ(refuted[13].light_ids, (std::vector<int>{0, 1, -1, -1}));
+  for (int k = 0; k < 18; ++k) {
+    if (k != 13) {
+      EXPECT_FALSE(refuted[k].refuted) << "frame " << k;
+    }
+  }
+
+  options.lone_refute_contradicted = 0;
+  std::vector<BridgedFrame> standing = frames;
+  BridgeFramesWithoutPose(camera_, dock_, 0.1, options, &standing);
+  EXPECT_FALSE(standing[13].refuted);
+
+  std::vector<BridgedFrame> true_lone = frames;
+  true_lone[13].detections = AllLights(Truth(13));
+  true_lone[13].own_light_ids = {0, 1, 2, 3, 4, 5};
+  true_lone[13].identified = 6;
+  true_lone[13].T_C_D = Measured(Truth(13));
+  BridgeFramesWithoutPose(camera_, dock_, 0.1, TwoWayLightBridgeOptions(), &true_lone);
+  EXPECT_FALSE(true_lone[13].refuted);
+}
+
 }  // namespace
 }  // namespace auvdock
