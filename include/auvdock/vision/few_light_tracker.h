@@ -47,7 +47,8 @@
 //            of pixels away.
 //   doubtful: a guiding light with no detection in its gate may take a doubtful candidate (one
 //            the detector rejected on appearance alone: a light too close to the lens to show
-//            its colour, blob_light_detector.h) in its gate, with that candidate's covariance:
+//            its colour, blob_light_detector.h; or a saturated disc wider than any blob,
+//            saturated_disc.h) in its gate, with that candidate's covariance:
 //            the nearest to the prediction, when every other doubtful candidate in the gate is
 //            the same blob at another scale (within its radius) and no other guiding light's
 //            gate holds it. Doubtful candidates are never judged (they are rejected already).
@@ -135,8 +136,8 @@ class FewLightTracker {
              double residual_sigma_px = 0.0);
 
   // The next frame in walking order: its detections and, optionally, its doubtful candidates
-  // (what the detector rejected on appearance alone, each with its centroid covariance). Nothing
-  // when the walk has ended (why: end_reason()).
+  // (what the detector rejected on appearance alone, and saturated discs, each with its centroid
+  // covariance). Nothing when the walk has ended (why: end_reason()).
   std::optional<FewLightStep> Step(const std::vector<LightDetection>& detections,
                                    const std::vector<LightDetection>& doubtful = {});
 

@@ -61,7 +61,8 @@ struct BridgedFrame {
   // The pose's residual per axis, a posteriori: rms_px sqrt(n / (2 n - 6)) for n lights (0:
   // unknown); a walk's detections are judged with the median of its start poses' at least.
   double residual_sigma_px = 0.0;
-  // Candidates the detector rejected on appearance alone (FewLightTracker::Step's doubtful ones).
+  // Candidates the detector rejected on appearance alone, and saturated discs (FewLightTracker::
+  // Step's doubtful ones).
   std::vector<LightDetection> doubtful;
   // Out: a frame whose pose a longer chain refuted (its pose is to be withdrawn) ...
   bool refuted = false;
