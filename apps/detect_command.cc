@@ -403,7 +403,11 @@ void RunDetect(const DetectOptions& options) {
   for (const FrameRecord& record : records) {
     n_pose += record.T_C_D.has_value();
     n_tracked += record.T_C_D && record.tracked;
-    if (record.status == "refuted") ++reasons["refuted by a longer run of poses"];
+    if (record.status == "refuted") {
+      ++reasons[record.reason.rfind("refuted: its lone pose", 0) == 0
+                    ? "refuted: a lone pose whose lights the neighbouring run of poses finds none"
+                    : "refuted by a longer run of poses"];
+    }
   }
   int n_detections = 0;
   std::map<std::string, FrameDetections> evaluated;
@@ -443,7 +447,7 @@ void RunDetect(const DetectOptions& options) {
     std::printf("  no pose: %d x %s\n", count, reason.c_str());
   }
   if (n_refuted > 0) {
-    std::printf("  %d tracked poses refuted by a longer run of poses (withdrawn)\n", n_refuted);
+    std::printf("  %d poses refuted by a longer run of poses (withdrawn)\n", n_refuted);
   }
   if (n_bridged > 0) {
     std::printf("  %d frames without a pose bridged by their neighbours' poses: %d lights "
