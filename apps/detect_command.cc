@@ -146,11 +146,11 @@ WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep
       const std::string from = std::to_string((*records)[walked.refuted_by].index);
       record.reason =
           walked.contradicted > 0
-              ? "refuted: its lone pose (" + std::to_string(walked.identified) + " lights) takes " +
+              ? "refuted: its lone pose (" + std::to_string(walked.identified()) + " lights) takes " +
                     std::to_string(walked.contradicted) +
                     " detections for lights that the run of poses from frame " + from +
                     " judges no light of the dock"
-              : "refuted: its tracked pose (" + std::to_string(walked.identified) +
+              : "refuted: its tracked pose (" + std::to_string(walked.identified()) +
                     " lights) is refuted by the longer run of poses from frame " + from +
                     ", whose walk labels more of its detections";
       record.status = "refuted";
@@ -216,6 +216,8 @@ void RunDetect(const DetectOptions& options) {
   if (files.empty()) throw InputError("--images: no file matches '" + options.images + "'");
   const CameraCalibration camera = LoadCameraCalibration(options.calib, options.camera);
   const DockModel dock = LoadDockModel(options.dock);
+  // The walks of the end (two_way_light_bridge.h), which follow tracked poses.
+  const bool walks = options.bridge != "off" && !options.no_tracking;
   LightColour colour;
   try {
     colour = ParseLightColour(options.colour.empty() ? dock.light_colour : options.colour);
@@ -313,8 +315,11 @@ void RunDetect(const DetectOptions& options) {
       d.covariance = r.covariance;
       record.doubtful.push_back(d);
     }
-    // A light within decimetres of the lens may be a saturated disc wider than any blob.
-    for (const LightDetection& d : FindSaturatedDiscs(image)) record.doubtful.push_back(d);
+    // A light within decimetres of the lens may be a saturated disc wider than any blob (only the
+    // walks of the end use doubtful candidates).
+    if (walks) {
+      for (const LightDetection& d : FindSaturatedDiscs(image)) record.doubtful.push_back(d);
+    }
     for (const LightDetection& d : frame.unexplained) {
       record.rejected.push_back({d.uv, d.radius_px, "not a light of the dock at the pose"});
     }
@@ -364,7 +369,7 @@ void RunDetect(const DetectOptions& options) {
   // files written frame by frame are then written anew with what the walks identified.
   int n_bridged = 0, n_bridge_identified = 0, n_bridge_unexplained = 0, n_refuted = 0;
   int n_bridge_accepted = 0;
-  if (!interrupted && options.bridge != "off" && !options.no_tracking) {
+  if (!interrupted && walks) {
     std::vector<BridgedFrame> frames(records.size());
     for (size_t k = 0; k < records.size(); ++k) {
       frames[k].detections = records[k].detections;
@@ -374,7 +379,6 @@ void RunDetect(const DetectOptions& options) {
       frames[k].tracked = records[k].tracked;
       frames[k].doubtful = records[k].doubtful;
       frames[k].own_light_ids = records[k].light_ids;
-      for (const int id : records[k].light_ids) frames[k].identified += id >= 0;
     }
     TwoWayLightBridgeOptions bridge_options;
     bridge_options.backward = options.bridge == "both";

@@ -109,7 +109,7 @@ class Bridge {
       if (!result) return;
       if (Stands(k)) {
         Chain& chain = chains_[other];
-        const bool decisive = result->labelled >= frame.identified + options_.refute_margin;
+        const bool decisive = result->labelled >= frame.identified() + options_.refute_margin;
         if (!record && decisive && own.size() > chain.frames.size()) {
           chain.refuted = true;
           chain.refuted_by = end;

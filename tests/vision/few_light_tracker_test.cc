@@ -63,6 +63,13 @@ class FewLightTrackerTest : public ::testing::Test {
     return out;
   }
 
+  // The ids of AllLights' detections, in their order.
+  std::vector<int> AllLightIds() const {
+    std::vector<int> ids;
+    for (const DockLight& light : dock_.lights) ids.push_back(light.id);
+    return ids;
+  }
+
   // What PnP would give: the truth perturbed by its covariance (1 mrad, 1 cm).
   Pose3 Measured(const Pose3& truth) {
     const Eigen::Vector3d dtheta(1e-3 * noise_(rng_), 1e-3 * noise_(rng_), 1e-3 * noise_(rng_));
@@ -255,7 +262,7 @@ TEST_F(FewLightTrackerTest, TheBridgeWalksBothWaysFromAPosedRunAndThroughALonePo
       frames[k].T_C_D = Measured(Truth(k));
       frames[k].covariance_local = PnpCovariance();
       frames[k].tracked = k >= 7 && k <= 10;  // 6 and the lone 12 from scratch
-      frames[k].identified = static_cast<int>(frames[k].detections.size());
+      frames[k].own_light_ids = AllLightIds();
     }
   }
   TwoWayLightBridgeOptions options;
@@ -288,7 +295,7 @@ TEST_F(FewLightTrackerTest, TheBridgePutsALightOnADoubtfulCandidate) {
       frames[k].T_C_D = Measured(T);
       frames[k].covariance_local = PnpCovariance();
       frames[k].tracked = k > 0;
-      frames[k].identified = static_cast<int>(frames[k].detections.size());
+      frames[k].own_light_ids = AllLightIds();
       continue;
     }
     frames[k].detections = {Detection(Project(T, 0))};
@@ -313,7 +320,7 @@ TEST_F(FewLightTrackerTest, ALongerChainRefutesAWrongTrackedChainBesideIt) {
     BridgedFrame& f = frames[k];
     if (k >= 10) {
       f.detections = AllLights(Truth(k));
-      f.identified = static_cast<int>(f.detections.size());
+      f.own_light_ids = AllLightIds();
       f.T_C_D = Measured(Truth(k));
     } else {
       // Every light and three specks; the wrong pose "identifies" light 4 and the specks.
@@ -323,7 +330,7 @@ TEST_F(FewLightTrackerTest, ALongerChainRefutesAWrongTrackedChainBesideIt) {
                                            Eigen::Vector2d(40.0, 470.0)}) {
         f.detections.push_back(Detection(corner));
       }
-      f.identified = 4;
+      f.own_light_ids = {-1, -1, -1, -1, 4, -1, 0, 1, 2};
       f.T_C_D = Pose3(Truth(k).q, Truth(k).p + Eigen::Vector3d(1.0, 0.0, 0.0));
     }
     f.covariance_local = PnpCovariance();
@@ -362,8 +369,7 @@ TEST_F(FewLightTrackerTest, ALonePoseThatTakesWhatTheWalkJudgesNoLightForLightsI
     BridgedFrame& f = frames[k];
     if (k < 10) {
       f.detections = AllLights(Truth(k));
-      f.own_light_ids = {0, 1, 2, 3, 4, 5};
-      f.identified = 6;
+      f.own_light_ids = AllLightIds();
       f.T_C_D = Measured(Truth(k));
       f.covariance_local = PnpCovariance();
       f.tracked = k > 0;
@@ -373,7 +379,6 @@ TEST_F(FewLightTrackerTest, ALonePoseThatTakesWhatTheWalkJudgesNoLightForLightsI
     if (k == 13) {
       f.detections.push_back(Detection(Project(Truth(k), 0) + Eigen::Vector2d(90.0, -60.0)));
       f.own_light_ids = {0, 1, 3, 4};
-      f.identified = 4;
       f.T_C_D = Pose3(Truth(k).q, Truth(k).p + Eigen::Vector3d(0.5, 0.0, 0.0));
       f.covariance_local = PnpCovariance();
     }
@@ -399,8 +404,7 @@ TEST_F(FewLightTrackerTest, ALonePoseThatTakesWhatTheWalkJudgesNoLightForLightsI
 
   std::vector<BridgedFrame> true_lone = frames;
   true_lone[13].detections = AllLights(Truth(13));
-  true_lone[13].own_light_ids = {0, 1, 2, 3, 4, 5};
-  true_lone[13].identified = 6;
+  true_lone[13].own_light_ids = AllLightIds();
   true_lone[13].T_C_D = Measured(Truth(13));
   BridgeFramesWithoutPose(camera_, dock_, 0.1, TwoWayLightBridgeOptions(), &true_lone);
   EXPECT_FALSE(true_lone[13].refuted);

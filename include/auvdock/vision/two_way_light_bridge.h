@@ -36,6 +36,7 @@
 // Units and frames: FewLightTracker's.
 #pragma once
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -56,7 +57,6 @@ struct BridgedFrame {
   std::optional<Pose3> T_C_D;
   Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
   bool tracked = false;  // the pose was tracked from the pose before it
-  int identified = 0;    // detections its own pose labelled
   std::vector<int> own_light_ids;  // per detection: its own pose's light id, or -1 (empty: none)
   // The pose's residual per axis, a posteriori: rms_px sqrt(n / (2 n - 6)) for n lights (0:
   // unknown); a walk's detections are judged with the median of its start poses' at least.
@@ -74,6 +74,12 @@ struct BridgedFrame {
   std::vector<int> light_ids;       // per detection: dock light id or -1
   std::vector<bool> unexplained;    // per detection: no light of the dock at the walk's pose
   std::vector<int> doubtful_light_ids;  // per doubtful candidate: the walk's light there, or -1
+
+  // Detections its own pose labelled.
+  int identified() const {
+    return static_cast<int>(
+        std::count_if(own_light_ids.begin(), own_light_ids.end(), [](int id) { return id >= 0; }));
+  }
 };
 
 struct TwoWayLightBridgeOptions {
