@@ -48,10 +48,13 @@ const Eigen::Vector3d kLumaBgr(0.114, 0.587, 0.299);
 const Eigen::Vector3d kParticleColourBgr(1.0, 1.0, 0.85);
 // Sand/mud is slightly warmer than grey, B G R.
 const Eigen::Vector3f kSeabedTintBgr(0.85f, 1.0f, 1.1f);
-// Each light sits in a dark (black anodised) housing flush with the deck, a disc of this many
-// light radii. Besides being what guide lights look like, it keeps the deck under a saturated
-// light core dark and flat, so clipping does not pull the intensity centroid along the lamp's
-// brightness gradient on the deck.
+// Each light sits in a dark (black anodised) housing, a horizontal disc of this many light radii
+// around the emitter: flush with the deck for a light on the deck (whose dome may stand up to its
+// own radius above it), at the light's own height on top of its mast for a raised light (higher
+// above the deck than its radius; the mast itself is not drawn).
+// Besides being what guide lights look like, it keeps the surface around a saturated light core
+// dark and flat, so clipping does not pull the intensity centroid along the lamp's brightness
+// gradient on the deck.
 constexpr double kHousingRadiusFactor = 4.0;
 // The lamp irradiance 1/r^2 is capped at this range (m) so a surface touching the camera stays
 // finite.
@@ -324,16 +327,21 @@ void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) co
   const float max_range = static_cast<float>(max_surface_range_m_);
   const float samples_per_m = static_cast<float>(kTransmissionSamplesPerM);
   const float min_lamp_range2 = kMinLampRangeM * kMinLampRangeM;
-  // Light housings on the deck: centres and squared radii, plus their common bounding box.
+  // Light housings: centres and squared radii. Those flush with the deck share a bounding box;
+  // a raised light's housing is a disc at its own height z (< 0: above the deck).
   struct Housing {
-    float x, y, radius2;
+    float x, y, z, radius2;
   };
-  std::vector<Housing> housings;
+  std::vector<Housing> housings, raised_housings;
   float box_min_x = 0.0f, box_max_x = -1.0f, box_min_y = 0.0f, box_max_y = -1.0f;
   for (const DockLight& light : dock_.lights) {
     const float radius = static_cast<float>(kHousingRadiusFactor * light.radius_m);
     const float x = static_cast<float>(light.p_D.x());
     const float y = static_cast<float>(light.p_D.y());
+    if (-light.p_D.z() > light.radius_m) {  // on a mast
+      raised_housings.push_back({x, y, static_cast<float>(light.p_D.z()), radius * radius});
+      continue;
+    }
     if (housings.empty()) {
       box_min_x = x - radius, box_max_x = x + radius, box_min_y = y - radius;
       box_max_y = y + radius;
@@ -341,7 +349,7 @@ void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) co
       box_min_x = std::min(box_min_x, x - radius), box_max_x = std::max(box_max_x, x + radius);
       box_min_y = std::min(box_min_y, y - radius), box_max_y = std::max(box_max_y, y + radius);
     }
-    housings.push_back({x, y, radius * radius});
+    housings.push_back({x, y, 0.0f, radius * radius});
   }
   const Eigen::Vector3f housing_albedo =
       Eigen::Vector3f::Constant(static_cast<float>(look_.housing_albedo));
@@ -359,7 +367,17 @@ void UnderwaterRenderer::RenderBackground(const Pose3& T_D_C, cv::Mat* image) co
     float surface_gain = 1.0f;
     Eigen::Vector3f albedo;
     if (dz > 0.0f) {  // looking down (+z of D)
-      if (oz < 0.0f) {
+      // A raised light's housing, seen from above, hides what lies behind it.
+      for (const Housing& housing : raised_housings) {
+        if (oz >= housing.z) continue;
+        const float s = (housing.z - oz) / dz;
+        const float hx = ox + s * dx - housing.x, hy = oy + s * dy - housing.y;
+        if (hx * hx + hy * hy <= housing.radius2 && s < max_range && (range < 0.0f || s < range)) {
+          range = s;
+          albedo = housing_albedo;
+        }
+      }
+      if (range < 0.0f && oz < 0.0f) {
         const float s = -oz / dz;
         const float x = ox + s * dx;
         const float y = oy + s * dy;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "auvdock/sim/water_model.h"
 #include "tests/testing/render_fixture.h"
@@ -313,6 +314,51 @@ TEST(UnderwaterRendererTest, InvisibleLightsAreNotReported) {
   EXPECT_GT(expected, 0);
   EXPECT_LT(expected, 6);
   EXPECT_EQ(renderer.Render(partial, rng).lights.size(), visible.size());
+}
+
+// A light on a mast 0.25 m above the deck sits in its own housing at its height: seen at a
+// slant, the dark disc is centred on the light's image. (Drawn flush with the deck below it, the
+// disc lay tens of pixels off to one side, and the edge under the light's glow biased centroids.)
+TEST(UnderwaterRendererTest, ARaisedLightsHousingIsCentredOnTheLight) {
+  const CameraCalibration camera = test::MakeRigCamera();
+  DockModel dock = LightsOffExcept(test::MakeTDock(), -1);
+  dock.lights.resize(1);
+  dock.lights[0].p_D = Eigen::Vector3d(0.0, 0.0, -0.25);
+  const UnderwaterRenderer renderer(camera, dock, WaterModel::ForType(WaterType::kClear),
+                                    CleanOptions());
+  for (double depression_deg : {35.0, 55.0, 90.0}) {
+    SCOPED_TRACE(depression_deg);
+    const Pose3 T_D_C = test::ApproachPose(2.5, depression_deg, dock.lights[0].p_D);
+    std::mt19937_64 rng(5);
+    const cv::Mat image = renderer.Render(T_D_C, rng).image;
+    const auto uv = camera.intrinsics.Project(T_D_C.Inverse() * dock.lights[0].p_D);
+    ASSERT_TRUE(uv.has_value());
+    // The disc (radius 0.2 m) spans ~fx 0.2 / 2.5 px across; look twice as far.
+    const double radius_px = camera.intrinsics.fx() * 0.2 / 2.5;
+    cv::Mat grey;
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+    const uint8_t centre_level = grey.at<uint8_t>(cvRound(uv->y()), cvRound(uv->x()));
+    auto around = [&](auto&& visit) {
+      for (int v = 0; v < grey.rows; ++v) {
+        for (int u = 0; u < grey.cols; ++u) {
+          const double du = u - uv->x(), dv = v - uv->y();
+          if (du * du + dv * dv <= 4.0 * radius_px * radius_px) visit(u, v, grey.at<uint8_t>(v, u));
+        }
+      }
+    };
+    int brightest_around = 0;
+    around([&](int, int, int level) { brightest_around = std::max(brightest_around, level); });
+    EXPECT_GT(brightest_around, centre_level + 20);  // the deck around is lit
+    const int cut = (centre_level + brightest_around) / 2;
+    double sum = 0.0, sum_u = 0.0, sum_v = 0.0;
+    around([&](int u, int v, int level) {
+      if (level < cut) sum += 1.0, sum_u += u, sum_v += v;  // the housing
+    });
+    ASSERT_GT(sum, 0.0);
+    // Perspective alone moves a slanted disc's image centroid toward its near half (1.4 px here);
+    // drawn on the deck below, the disc was 7 px (35 deg) to 25 px (55 deg) off.
+    EXPECT_LT(std::hypot(sum_u / sum - uv->x(), sum_v / sum - uv->y()), 2.5);
+  }
 }
 
 TEST(UnderwaterRendererTest, TurbidWaterDimsTheLights) {
