@@ -1,10 +1,12 @@
-// auvdock detect --images "DIR/*.jpg" --calib FILE [--camera NAME] --dock FILE --out DIR
+// auvdock detect (--images "DIR/*.jpg" | --video FILE) --calib FILE [--camera NAME] --dock FILE
+//                --out DIR
 //                [--overlay] [--labels FILE [--label-max-range M]] [--colour C] [--deinterlace]
 //                [--no-tracking] [--no-second-look] [--keep-unexplained] [--bridge B]
 //                [--gravity-camera X Y Z] [--min-halo-excess GRAY]
 //
 // A first look at one's own footage: the real-water light detector, the identification and the
-// mono pose on every image, in name order (MonoLightPipeline: with a second look for the lights
+// mono pose on every image, in name order, or every frame of a video (footage_source.h: frames
+// named frame_NNNNNN, timed by the file's time stamps) (MonoLightPipeline: with a second look for the lights
 // that the first pass missed where the tracked or the new pose puts them, and over the whole image
 // at laxer thresholds when there is no pose; --no-second-look: the first pass only); the halo
 // colour threshold is learned from the identified lights (HaloColourLearner) unless given. The
@@ -58,6 +60,7 @@
 
 #include "apps/commands.h"
 #include "apps/detect_output.h"
+#include "apps/footage_source.h"
 #include "apps/help_text.h"
 #include "apps/reason_class.h"
 #include "apps/signal_flag.h"
@@ -80,6 +83,7 @@ namespace {
 
 struct DetectOptions {
   std::string images;
+  std::string video;
   std::string calib;
   std::string camera;
   std::string dock;
@@ -206,15 +210,14 @@ WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep
 }
 
 void RunDetect(const DetectOptions& options) {
-  std::vector<cv::String> files;
-  try {
-    cv::glob(options.images, files, false);
-  } catch (const cv::Exception&) {
-    files.clear();
+  if (options.images.empty() == options.video.empty()) {
+    throw InputError("detect: give the footage as --images \"DIR/*.jpg\" or as --video FILE");
   }
-  std::sort(files.begin(), files.end());
-  if (files.empty()) throw InputError("--images: no file matches '" + options.images + "'");
   const CameraCalibration camera = LoadCameraCalibration(options.calib, options.camera);
+  FootageSource footage = options.video.empty()
+                              ? FootageSource::Images(options.images, camera.rate_hz)
+                              : FootageSource::Video(options.video, camera.rate_hz);
+  const char* unit = footage.is_video() ? "video frames" : "images";
   const DockModel dock = LoadDockModel(options.dock);
   // The walks of the end (two_way_light_bridge.h), which follow tracked poses.
   const bool walks = options.bridge != "off" && !options.no_tracking;
@@ -266,17 +269,16 @@ void RunDetect(const DetectOptions& options) {
   int n_guided = 0, n_weak_pass = 0;
   double detect_s = 0.0, pose_s = 0.0;
   bool interrupted = false;
-  for (size_t f = 0; f < files.size(); ++f) {
+  FootageFrame footage_frame;
+  while (true) {
     if (cancel.IsCancelled()) {
       interrupted = true;
       break;
     }
-    const std::string& path = files[f];
-    const std::string name = fs::path(path).filename().string();
-    cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-    if (image.empty()) throw InputError(path + ": cannot decode the image");
-    if (image.depth() != CV_8U) throw InputError(path + ": not an 8-bit image");
-    if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
+    if (!footage.Next(&footage_frame)) break;
+    const std::string& path = footage_frame.origin;
+    const std::string& name = footage_frame.name;
+    const cv::Mat& image = footage_frame.image;
     if (image.cols != camera.intrinsics.width() || image.rows != camera.intrinsics.height()) {
       throw InputError(path + ": the image is " + std::to_string(image.cols) + "x" +
                        std::to_string(image.rows) + ", the calibration " +
@@ -290,8 +292,8 @@ void RunDetect(const DetectOptions& options) {
     MonoLightFrame frame = pipeline.Process(image);
     const MonoPoseResult& pose = frame.pose;
     FrameRecord record;
-    record.index = static_cast<int>(f);
-    record.time_s = f / camera.rate_hz;
+    record.index = footage_frame.index;
+    record.time_s = footage_frame.time_s;
     record.path = path;
     record.name = name;
     record.detections = frame.detections;
@@ -360,10 +362,20 @@ void RunDetect(const DetectOptions& options) {
     if (!options.overlay) record.rejected.clear();  // only rejected.csv needs them later
     records.push_back(std::move(record));
     if (!options.quiet && n_frames % 25 == 0) {
-      std::fprintf(stderr, "\rdetect: %d/%zu images", n_frames, files.size());
+      if (footage.announced_frames() > 0) {
+        std::fprintf(stderr, "\rdetect: %d/%d %s", n_frames, footage.announced_frames(), unit);
+      } else {
+        std::fprintf(stderr, "\rdetect: %d %s", n_frames, unit);
+      }
     }
   }
   if (!options.quiet) std::fprintf(stderr, "\n");
+  if (footage.ended_early()) {
+    std::fprintf(stderr,
+                 "detect: warning: the video ended after %d frames; its header announces %d "
+                 "(a damaged or cut file?)\n",
+                 n_frames, footage.announced_frames());
+  }
 
   // The frames without a pose, from the posed frames beside them (two_way_light_bridge.h); the
   // files written frame by frame are then written anew with what the walks identified.
@@ -383,7 +395,7 @@ void RunDetect(const DetectOptions& options) {
     TwoWayLightBridgeOptions bridge_options;
     bridge_options.backward = options.bridge == "both";
     bridge_options.tracker.pixel_noise_px = camera.pixel_noise_px;
-    n_bridged = BridgeFramesWithoutPose(camera.intrinsics, dock, 1.0 / camera.rate_hz,
+    n_bridged = BridgeFramesWithoutPose(camera.intrinsics, dock, footage.frame_interval_s(),
                                         bridge_options, &frames);
     const WalkRevision revision =
         ReviseByTheWalks(frames, options.keep_unexplained, &records, &rejected_reasons);
@@ -394,7 +406,7 @@ void RunDetect(const DetectOptions& options) {
     if (options.overlay) {
       for (size_t k = 0; k < records.size(); ++k) {
         if (!frames[k].refuted && !frames[k].bridged) continue;
-        const cv::Mat image = cv::imread(records[k].path, cv::IMREAD_UNCHANGED);
+        const cv::Mat image = footage.Reread(records[k].index);
         if (image.empty()) continue;
         DrawOverlay(image, records[k].detections, records[k].light_ids, records[k].rejected,
                     options.out + "/overlay/" + fs::path(records[k].name).stem().string() +
@@ -423,7 +435,8 @@ void RunDetect(const DetectOptions& options) {
   }
 
   nlohmann::ordered_json summary;
-  summary["images"] = files.size();
+  summary["footage"] = footage.is_video() ? options.video : options.images;
+  summary["images"] = footage.announced_frames();  // a video: what its header announces (0: not said)
   summary["frames"] = n_frames;
   summary["interrupted"] = interrupted;
   summary["frames_with_pose"] = n_pose;
@@ -445,8 +458,8 @@ void RunDetect(const DetectOptions& options) {
       {"identified_median", colour_learner.median_excess() ? *colour_learner.median_excess() : 0.0}};
   summary["time_per_frame_ms"] = {{"detect", n_frames ? 1e3 * detect_s / n_frames : 0.0},
                                   {"identify_and_pose", n_frames ? 1e3 * pose_s / n_frames : 0.0}};
-  std::printf("detect: %d images -> %s: %d with a pose (%d tracked), %d detections\n", n_frames,
-              options.out.c_str(), n_pose, n_tracked, n_detections);
+  std::printf("detect: %d %s -> %s: %d with a pose (%d tracked), %d detections\n", n_frames,
+              unit, options.out.c_str(), n_pose, n_tracked, n_detections);
   for (const auto& [reason, count] : reasons) {
     std::printf("  no pose: %d x %s\n", count, reason.c_str());
   }
@@ -514,8 +527,13 @@ void AddDetectCommand(CLI::App& root) {
       "detections.csv, frames.csv, camera_poses.tum, camera_pose_covariance.csv, summary.json "
       "[, overlay/]");
   sub->footer(DetectHelp());
-  sub->add_option("--images", options->images, "Image files, a glob pattern: \"DIR/*.jpg\"")
-      ->required();
+  CLI::Option* images =
+      sub->add_option("--images", options->images, "Image files, a glob pattern: \"DIR/*.jpg\"");
+  sub->add_option("--video", options->video,
+                  "A video file instead of --images (what OpenCV's FFmpeg or GStreamer reader "
+                  "opens: mp4, avi, mkv, ...); its frames are named frame_000000, frame_000001, "
+                  "... in the outputs and the labels")
+      ->excludes(images);
   sub->add_option("--calib", options->calib,
                   "calibration.yaml (auvdock) or an OpenCV FileStorage calibration")
       ->required();

@@ -113,16 +113,20 @@ std::string PnpHelp() {
 }
 
 std::string DetectHelp() {
-  return "\nNeeds: your images (a glob), a camera calibration (ours or OpenCV FileStorage) and a\n"
-         "dock.yaml (the light layout, and its colour). " +
+  return "\nNeeds: your images (a glob) or a video file, a camera calibration (ours or OpenCV\n"
+         "FileStorage) and a dock.yaml (the light layout, and its colour). " +
          Shipped("Shipped docks", "docks") +
          "Writes into --out: detections.csv (with identities), frames.csv (per image: status,\n"
          "pose, reason), camera_poses.tum (T_D_C), summary.json; with --overlay overlay/*.png\n"
          "and rejected.csv; with --labels, recall, precision and centroid RMS in summary.json.\n"
          "Images with too few lights for a pose are identified at the end from the posed images\n"
          "before and after them (--bridge; the files are then written anew).\n"
+         "A video's frames are named frame_000000, frame_000001, ... (in the outputs and the\n"
+         "labels) and timed by the file's time stamps.\n"
          "Example: auvdock detect --images \"frames/*.jpg\" --calib calib.yaml --dock dock.yaml "
-         "--out out/detect --overlay\n";
+         "--out out/detect --overlay\n"
+         "         auvdock detect --video dive.mp4 --calib calib.yaml --dock dock.yaml --out "
+         "out/detect\n";
 }
 
 std::string DemoHelp() {

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/videoio.hpp>
 
 #include "auvdock/geometry/pose3.h"
 #include "auvdock/geometry/so3.h"
@@ -334,6 +335,59 @@ TEST(DetectCli, GravityResolvesAnUprightRing) {
   EXPECT_NE(frames.find("chosen by gravity"), std::string::npos) << frames;
 }
 
+// The footage as a video file (Motion JPEG, written by OpenCV's own encoder) instead of images:
+// the same lights, poses and identities; frames named frame_NNNNNN (in the outputs and the labels)
+// and timed by the file's rate (25/s here, where the calibration says 10/s).
+TEST(DetectCli, AVideosFramesAreDetectedAsItsImagesAre) {
+  Footage footage;
+  std::filesystem::create_directories(footage.dir / "frames");
+  MakeFootage(&footage, 12, /*faded_light=*/-1, /*partial_from=*/8);
+  const std::string video = footage.dir / "footage.avi";
+  cv::VideoWriter writer(video, cv::CAP_OPENCV_MJPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'),
+                         25.0, cv::Size(640, 480));
+  ASSERT_TRUE(writer.isOpened());
+  writer.set(cv::VIDEOWRITER_PROP_QUALITY, 100);
+  for (int f = 0; f < 12; ++f) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "frames/f%03d.png", f);
+    writer.write(cv::imread(footage.dir / name));
+  }
+  writer.release();
+  // The labels by the video's frame names.
+  std::string labels = test::ReadTextFile(footage.dir / "labels.csv");
+  for (size_t at = labels.find("f0"); at != std::string::npos; at = labels.find("f0", at)) {
+    const int f = std::stoi(labels.substr(at + 1, 3));
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%06d", f);
+    labels.replace(at, 8, name);  // fNNN.png
+  }
+  test::WriteTextFile(footage.dir / "video_labels.csv", labels);
+
+  const std::string out = footage.dir / "out";
+  std::vector<std::string> args = DetectArgs(footage, out);
+  args[1] = "--video";
+  args[2] = video;
+  args[10] = footage.dir / "video_labels.csv";
+  const test::CommandResult r = test::RunAuvdock(args);
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("detect: 12 video frames"), std::string::npos) << r.out;
+  const nlohmann::json summary = nlohmann::json::parse(test::ReadTextFile(out + "/summary.json"));
+  EXPECT_EQ(summary["footage"], video);
+  EXPECT_EQ(summary["frames"], 12);
+  EXPECT_EQ(summary["frames_with_pose"], 8);
+  EXPECT_EQ(summary["labels"]["frames"], 12);
+  EXPECT_EQ(summary["labels"]["recall"], 1.0);
+  EXPECT_EQ(summary["labels"]["precision"], 1.0);
+  EXPECT_LT(summary["labels"]["centroid_rms_px"].get<double>(), 0.3);
+  ExpectEveryDetectionIdentifiedConsistently(footage, out, 8);
+  EXPECT_TRUE(std::filesystem::exists(out + "/overlay/frame_000011.png"));
+  const Trajectory poses = ReadTumTrajectory(out + "/camera_poses.tum");
+  ASSERT_EQ(poses.size(), 8u);
+  EXPECT_NEAR(static_cast<double>(poses[7].t_ns), 7 * 0.04e9, 1e3);
+  const std::string frames = test::ReadTextFile(out + "/frames.csv");
+  EXPECT_NE(frames.find("\n11,frame_000011,"), std::string::npos) << frames;
+}
+
 void ExpectOneLineExitTwo(const std::vector<std::string>& args, const std::string& needle) {
   const test::CommandResult r = test::RunAuvdock(args);
   EXPECT_EQ(r.exit_status, 2) << r.err;
@@ -393,6 +447,17 @@ TEST(DetectCli, BadInputIsOneLineAndExitTwo) {
   a.push_back("--colour");
   a.push_back("purple");
   ExpectOneLineExitTwo(a, "--colour: purple not in {white,blue,green,blue_green,red}");
+
+  a = args("o6");
+  a[1] = "--video";
+  a[2] = footage.dir / "calibration.yaml";
+  ExpectOneLineExitTwo(a, "--video: " + footage.dir / "calibration.yaml");
+  a = args("o7");
+  a.insert(a.begin() + 3, {"--video", footage.dir / "calibration.yaml"});
+  ExpectOneLineExitTwo(a, "--images excludes --video");
+  a = args("o8");
+  a.erase(a.begin() + 1, a.begin() + 3);
+  ExpectOneLineExitTwo(a, "give the footage as --images");
 }
 
 }  // namespace
