@@ -21,9 +21,13 @@ PoseVerdict::PoseVerdict(const DockModel& dock, const PinholeRadtanCamera& camer
   judges_ = num_lights >= options.min_support * static_cast<double>(predicted_.size());
 }
 
-bool PoseVerdict::NearALight(const LightDetection& detection) const {
+bool PoseVerdict::NearALight(const LightDetection& detection,
+                             const std::vector<int>& taken_ids) const {
   const double g = options_.gate_sigmas;
   return std::any_of(predicted_.begin(), predicted_.end(), [&](const PredictedLight& p) {
+    if (std::find(taken_ids.begin(), taken_ids.end(), p.light_id) != taken_ids.end()) {
+      return false;
+    }
     const double sigma = std::sqrt(std::max(0.0, p.covariance.eigenvalues().real().maxCoeff()));
     const double radius = g * sigma + std::max({options_.floor_px, p.radius_px, g * rms_px_});
     return (detection.uv - p.uv).norm() <= radius;
@@ -34,9 +38,13 @@ std::vector<bool> NoLightOfTheDock(const std::vector<LightDetection>& detections
                                    const std::vector<int>& ids, const PoseVerdict& verdict) {
   std::vector<bool> none(detections.size(), false);
   if (!verdict.judges()) return none;
+  std::vector<int> taken;
+  for (int id : ids) {
+    if (id >= 0) taken.push_back(id);
+  }
   for (size_t i = 0; i < detections.size(); ++i) {
     if (i < ids.size() && ids[i] >= 0) continue;
-    none[i] = !verdict.NearALight(detections[i]);
+    none[i] = !verdict.NearALight(detections[i], taken);
   }
   return none;
 }

@@ -62,6 +62,22 @@ TEST(PoseVerdict, WhatLiesFarFromEveryPredictedLightIsNoLightOfTheDock) {
   EXPECT_EQ(none, std::vector<bool>({false, true, false}));
 }
 
+// A second detection beside a light that another detection is already identified as is not a
+// light of the dock; beside a light not yet taken it stays.
+TEST(PoseVerdict, ASecondDetectionOfATakenLightIsNoLightOfTheDock) {
+  const Scene scene;
+  const Pose3 T_C_D = ViewFromAbove(4.0, 0.3);
+  const PoseVerdict verdict = scene.Verdict(T_C_D, 6);
+  const Eigen::Vector2d light = scene.Pixel(T_C_D, 2);
+  const LightDetection beside = At(light + Eigen::Vector2d(2.0, 2.0));
+  EXPECT_TRUE(verdict.NearALight(beside));
+  EXPECT_TRUE(verdict.NearALight(beside, {0, 1}));
+  EXPECT_FALSE(verdict.NearALight(beside, {2}));
+  const std::vector<LightDetection> detections = {At(light), beside};
+  EXPECT_EQ(NoLightOfTheDock(detections, {2, -1}, verdict), std::vector<bool>({false, true}));
+  EXPECT_EQ(NoLightOfTheDock(detections, {-1, -1}, verdict), std::vector<bool>({false, false}));
+}
+
 TEST(PoseVerdict, APoseThatIdentifiesFewOfTheLightsInViewDoesNotJudge) {
   const Scene scene;
   const Pose3 T_C_D = ViewFromAbove(4.0, 0.3);

@@ -8,7 +8,11 @@
 // the image, rms the pose fit's residual (a poor camera model makes it large) and g =
 // gate_sigmas. Only a pose that identifies at least min_support of the lights it puts in the
 // image judges at all: with a poor camera model a pose fits a few lights and misplaces the others
-// (on the real pool clip's second model, 4 of 7 LEDs).
+// (on the real pool clip's second model, 4 of 7 LEDs). A light that the pose already identifies
+// with another detection is taken: a detection near taken lights only is a second detection of a
+// light (a reflection beside it, a second blob of a glow cut by the border) and none of the
+// dock's lights either. (On the pool clip taken from its last frame to its first, one LED at the
+// border gave two detections 6 px apart, and the second was kept unidentified.)
 //
 // Not done: where labellings tie (no pose), letting the tied poses judge together (what none of
 // them puts near a light goes). Measured on the randomised renders, seeds 1-5, it took precision
@@ -45,7 +49,8 @@ class PoseVerdict {
               const PoseVerdictOptions& options);
 
   bool judges() const { return judges_; }
-  bool NearALight(const LightDetection& detection) const;
+  // Near a light whose id is not in taken_ids.
+  bool NearALight(const LightDetection& detection, const std::vector<int>& taken_ids = {}) const;
 
  private:
   std::vector<PredictedLight> predicted_;
@@ -55,7 +60,8 @@ class PoseVerdict {
 };
 
 // Per detection: true when it is none of the dock's lights by the verdict (it judges, and puts
-// no light near it). Identified detections (ids[i] >= 0) are never.
+// no light near it that another detection is not already identified as). Identified detections
+// (ids[i] >= 0) are never.
 std::vector<bool> NoLightOfTheDock(const std::vector<LightDetection>& detections,
                                    const std::vector<int>& ids, const PoseVerdict& verdict);
 
