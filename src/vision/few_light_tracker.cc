@@ -323,11 +323,16 @@ std::optional<FewLightStep> FewLightTracker::Step(const std::vector<LightDetecti
   }
   if (!observed.empty()) unlabelled_frames_ = 0;
   // Verdict, against the prediction's gates (the wider ones), of every light in front of the
-  // camera: a model that misplaces a light may put it just outside the image.
+  // camera: a model that misplaces a light may put it just outside the image. A light labelled
+  // with another detection (or doubtful candidate) is taken: near it is a second detection.
+  std::vector<bool> taken(n_light, false);
+  for (const auto& [j, l] : labels) taken[l] = true;
+  for (const auto& [k, l] : doubtful_labels) taken[l] = true;
   for (size_t j = 0; j < n_det; ++j) {
     if (step.light_ids[j] >= 0) continue;
     bool near_a_light = false;
     for (size_t l = 0; l < n_light; ++l) {
+      if (taken[l]) continue;
       const double distance = (detections[j].uv - lights[l].uv).norm();
       near_a_light |= d2[j][l] <= options_.unexplained_chi2 ||
                       distance <= options_.unexplained_floor_px ||

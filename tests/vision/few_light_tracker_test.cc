@@ -223,6 +223,30 @@ TEST_F(FewLightTrackerTest, NeverGuessesBetweenTwoDetectionsInOneLightsGate) {
   EXPECT_EQ(step->unexplained, (std::vector<bool>{false, false, false}));
 }
 
+// A glint 12 px beside a light that another detection is labelled as is a second detection of
+// that light, no light of the dock; with that light unlabelled it might be the light, and stays.
+TEST_F(FewLightTrackerTest, AGlintBesideALabelledLightIsNoLightOfTheDock) {
+  FewLightTracker tracker(camera_, dock_, 0.1);
+  ASSERT_TRUE(StartFromPoses(&tracker, 0, 5));
+  const Pose3 T = Truth(6);
+  const Eigen::Vector2d stem = (Project(T, 1) - Project(T, 0)).normalized();
+  const Eigen::Vector2d across(-stem.y(), stem.x());
+  const LightDetection glint = Detection(Project(T, 0) + 12.0 * across);
+  const std::optional<FewLightStep> step =
+      tracker.Step({Detection(Project(T, 0)), Detection(Project(T, 1)), glint});
+  ASSERT_TRUE(step) << tracker.end_reason();
+  EXPECT_EQ(step->light_ids, (std::vector<int>{0, 1, -1}));
+  EXPECT_EQ(step->unexplained, (std::vector<bool>{false, false, true}));
+
+  FewLightTracker other(camera_, dock_, 0.1);
+  ASSERT_TRUE(StartFromPoses(&other, 0, 5));
+  const std::optional<FewLightStep> without_light_0 =
+      other.Step({Detection(Project(T, 1)), glint});
+  ASSERT_TRUE(without_light_0) << other.end_reason();
+  EXPECT_EQ(without_light_0->light_ids, (std::vector<int>{1, -1}));
+  EXPECT_EQ(without_light_0->unexplained, (std::vector<bool>{false, false}));
+}
+
 TEST_F(FewLightTrackerTest, AJerkTheRateCannotFollowIsNotJudgedAndEndsTheWalk) {
   FewLightTracker tracker(camera_, dock_, 0.1);
   ASSERT_TRUE(StartFromPoses(&tracker, 0, 5));
