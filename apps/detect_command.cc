@@ -72,6 +72,7 @@
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/light_labels_csv.h"
 #include "auvdock/io/staged_directory.h"
+#include "auvdock/vision/identified_light_pose.h"
 #include "auvdock/vision/mono_light_pipeline.h"
 #include "auvdock/vision/saturated_disc.h"
 #include "auvdock/vision/two_way_light_bridge.h"
@@ -209,6 +210,40 @@ WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep
   return revision;
 }
 
+// A frame without a pose of its own whose lights a walk identified (at least 4) gets the pose
+// of those lights (identified_light_pose.h), started at the walk's pose: its reason and the
+// no-pose counts say so. Returns how many frames were posed.
+int PoseFromTheWalksLabels(const CameraCalibration& camera, const DockModel& dock,
+                           const std::vector<BridgedFrame>& frames,
+                           std::vector<FrameRecord>* records,
+                           std::map<std::string, int>* no_pose_reasons) {
+  int posed = 0;
+  for (size_t k = 0; k < records->size(); ++k) {
+    FrameRecord& record = (*records)[k];
+    const BridgedFrame& walked = frames[k];
+    if (record.T_C_D || !walked.bridged || !walked.walk_T_C_D) continue;
+    const IdentifiedLightPose pose = PoseFromIdentifiedLights(
+        camera, dock, record.detections, record.light_ids, *walked.walk_T_C_D);
+    if (!pose.T_C_D) continue;
+    record.T_C_D = pose.T_C_D;
+    record.covariance_local = pose.covariance_local;
+    record.rms_px = pose.rms_px;
+    record.pixel_sigma_px = pose.pixel_sigma_px;
+    record.residual_sigma_px =
+        pose.rms_px * std::sqrt(pose.num_lights / (2.0 * pose.num_lights - 6.0));
+    record.status = "ok";
+    record.tracked = false;
+    record.reason = "posed from the " + std::to_string(pose.num_lights) +
+                    " lights that the walk identified (on its own: " + record.reason + ")";
+    record.symmetry = "identities carried by the walk from frame " +
+                      std::to_string((*records)[walked.anchor_frame].index);
+    auto count = no_pose_reasons->find(record.no_pose_class);
+    if (count != no_pose_reasons->end() && --count->second == 0) no_pose_reasons->erase(count);
+    ++posed;
+  }
+  return posed;
+}
+
 void RunDetect(const DetectOptions& options) {
   if (options.images.empty() == options.video.empty()) {
     throw InputError("detect: give the footage as --images \"DIR/*.jpg\" or as --video FILE");
@@ -342,7 +377,10 @@ void RunDetect(const DetectOptions& options) {
       ++rejected_reasons[kind];
     }
     record.reason = pose.reason;
-    if (!pose.T_C_D) ++reasons[ReasonClass(pose.reason)];
+    if (!pose.T_C_D) {
+      record.no_pose_class = ReasonClass(pose.reason);
+      ++reasons[record.no_pose_class];
+    }
     if (!pose.T_C_D && !rejected_here.empty() &&
         static_cast<int>(detections.size()) < pipeline_options.poser.min_lights) {
       const auto most = std::max_element(
@@ -380,7 +418,7 @@ void RunDetect(const DetectOptions& options) {
   // The frames without a pose, from the posed frames beside them (two_way_light_bridge.h); the
   // files written frame by frame are then written anew with what the walks identified.
   int n_bridged = 0, n_bridge_identified = 0, n_bridge_unexplained = 0, n_refuted = 0;
-  int n_bridge_accepted = 0;
+  int n_bridge_accepted = 0, n_posed_from_walks = 0;
   if (!interrupted && walks) {
     std::vector<BridgedFrame> frames(records.size());
     for (size_t k = 0; k < records.size(); ++k) {
@@ -403,6 +441,7 @@ void RunDetect(const DetectOptions& options) {
     n_bridge_identified = revision.identified;
     n_bridge_unexplained = revision.unexplained;
     n_bridge_accepted = revision.accepted;
+    n_posed_from_walks = PoseFromTheWalksLabels(camera, dock, frames, &records, &reasons);
     if (options.overlay) {
       for (size_t k = 0; k < records.size(); ++k) {
         if (!frames[k].refuted && !frames[k].bridged) continue;
@@ -444,6 +483,7 @@ void RunDetect(const DetectOptions& options) {
   summary["frames_without_detection"] = n_no_detection;
   summary["detections"] = n_detections;
   summary["frames_refuted"] = n_refuted;
+  summary["frames_posed_from_walks"] = n_posed_from_walks;
   summary["bridged_frames"] = {{"frames", n_bridged},
                                {"identified", n_bridge_identified},
                                {"unexplained", n_bridge_unexplained},
@@ -465,6 +505,11 @@ void RunDetect(const DetectOptions& options) {
   }
   if (n_refuted > 0) {
     std::printf("  %d poses refuted by a longer run of poses (withdrawn)\n", n_refuted);
+  }
+  if (n_posed_from_walks > 0) {
+    std::printf("  %d frames without a pose of their own posed from the lights that the walks "
+                "identified\n",
+                n_posed_from_walks);
   }
   if (n_bridged > 0) {
     std::printf("  %d frames without a pose bridged by their neighbours' poses: %d lights "

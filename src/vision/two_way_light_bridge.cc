@@ -137,6 +137,7 @@ class Bridge {
       frame.light_ids = result->light_ids;
       frame.unexplained = result->unexplained;
       frame.doubtful_light_ids = result->doubtful_light_ids;
+      frame.walk_T_C_D = result->T_C_D;
     }
   }
 

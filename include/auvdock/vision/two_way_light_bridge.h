@@ -74,6 +74,7 @@ struct BridgedFrame {
   std::vector<int> light_ids;       // per detection: dock light id or -1
   std::vector<bool> unexplained;    // per detection: no light of the dock at the walk's pose
   std::vector<int> doubtful_light_ids;  // per doubtful candidate: the walk's light there, or -1
+  std::optional<Pose3> walk_T_C_D;      // the walk's (filtered) pose of the frame
 
   // Detections its own pose labelled.
   int identified() const {
