@@ -211,8 +211,9 @@ WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep
 }
 
 // A frame without a pose of its own whose lights a walk identified (at least 4) gets the pose
-// of those lights (identified_light_pose.h), started at the walk's pose: its reason and the
-// no-pose counts say so. Returns how many frames were posed.
+// of those lights (identified_light_pose.h), started at the walk's pose; a light that does not
+// fit it loses its identity. Its reason and the no-pose counts say so. Returns how many frames
+// were posed.
 int PoseFromTheWalksLabels(const CameraCalibration& camera, const DockModel& dock,
                            const std::vector<BridgedFrame>& frames,
                            std::vector<FrameRecord>* records,
@@ -225,6 +226,11 @@ int PoseFromTheWalksLabels(const CameraCalibration& camera, const DockModel& doc
     const IdentifiedLightPose pose = PoseFromIdentifiedLights(
         camera, dock, record.detections, record.light_ids, *walked.walk_T_C_D);
     if (!pose.T_C_D) continue;
+    int left_out = 0;
+    for (size_t i = 0; i < record.light_ids.size(); ++i) {
+      left_out += record.light_ids[i] >= 0 && pose.light_ids[i] < 0;
+    }
+    record.light_ids = pose.light_ids;
     record.T_C_D = pose.T_C_D;
     record.covariance_local = pose.covariance_local;
     record.rms_px = pose.rms_px;
@@ -234,7 +240,11 @@ int PoseFromTheWalksLabels(const CameraCalibration& camera, const DockModel& doc
     record.status = "ok";
     record.tracked = false;
     record.reason = "posed from the " + std::to_string(pose.num_lights) +
-                    " lights that the walk identified (on its own: " + record.reason + ")";
+                    " lights that the walk identified" +
+                    (left_out > 0 ? " (" + std::to_string(left_out) +
+                                        " more left out: not fitting that pose)"
+                                  : std::string()) +
+                    " (on its own: " + record.reason + ")";
     record.symmetry = "identities carried by the walk from frame " +
                       std::to_string((*records)[walked.anchor_frame].index);
     auto count = no_pose_reasons->find(record.no_pose_class);
@@ -335,6 +345,11 @@ void RunDetect(const DetectOptions& options) {
     record.light_ids = pose.light_ids;
     record.status = pose.T_C_D ? "ok" : MatchStatusName(pose.status);
     record.tracked = pose.tracked;
+    int left_out = 0;
+    for (size_t i = 0; i < record.light_ids.size(); ++i) {
+      left_out += record.light_ids[i] >= 0 && pose.light_ids[i] < 0;
+    }
+    record.light_ids = pose.light_ids;
     record.T_C_D = pose.T_C_D;
     record.covariance_local = pose.covariance_local;
     record.rms_px = pose.rms_px;

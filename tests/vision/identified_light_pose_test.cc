@@ -1,6 +1,6 @@
 // PoseFromIdentifiedLights (identified_light_pose.h): the pose of lights identified by a walk,
-// from the walk's pose; refused with fewer than 4 lights, with a wrong identity (the lights do not
-// fit one pose), and where PnP lands far from the walk's pose.
+// from the walk's pose; a glint taken for a light is left out; refused with fewer than 4 lights,
+// with 4 that fit no pose, and where PnP lands far from the walk's pose.
 #include "auvdock/vision/identified_light_pose.h"
 
 #include <cmath>
@@ -57,6 +57,7 @@ TEST_F(IdentifiedLightPoseTest, ThePoseOfTheIdentifiedLights) {
   EXPECT_LT(pose.rms_px, 1.0);
   EXPECT_GT(pose.covariance_local.trace(), 0.0);
   EXPECT_TRUE(pose.reason.empty());
+  EXPECT_EQ(pose.light_ids, ids_);
 }
 
 TEST_F(IdentifiedLightPoseTest, FewerThanFourLightsGiveNoPose) {
@@ -68,12 +69,33 @@ TEST_F(IdentifiedLightPoseTest, FewerThanFourLightsGiveNoPose) {
   EXPECT_EQ(pose.reason, "3 identified lights (need 4)");
 }
 
-TEST_F(IdentifiedLightPoseTest, AWrongIdentityGivesNoPose) {
-  // The T's stem end and the bar's end swapped: no pose fits both at 0.3 px.
+TEST_F(IdentifiedLightPoseTest, AGlintTakenForALightIsLeftOut) {
+  // Light 3's own detection left unidentified, and a glint 6 px from it identified as light 3.
+  std::vector<LightDetection> detections = detections_;
   std::vector<int> ids = ids_;
-  std::swap(ids[0], ids[5]);
+  LightDetection glint = detections_[3];
+  glint.uv += Eigen::Vector2d(6.0, -2.0);
+  detections.push_back(glint);
+  ids.push_back(3);
+  ids[3] = -1;
   const IdentifiedLightPose pose =
-      PoseFromIdentifiedLights(camera_, dock_, detections_, ids, Start(1.0));
+      PoseFromIdentifiedLights(camera_, dock_, detections, ids, Start(1.0));
+  ASSERT_TRUE(pose.T_C_D) << pose.reason;
+  EXPECT_EQ(pose.num_lights, 5);
+  std::vector<int> expected = ids;
+  expected.back() = -1;
+  EXPECT_EQ(pose.light_ids, expected);
+  EXPECT_LT((pose.T_C_D->p - truth_.p).norm(), 0.05);
+}
+
+TEST_F(IdentifiedLightPoseTest, FourLightsThatFitNoPoseGiveNone) {
+  // Four lights, one of them the glint: nothing to leave out.
+  std::vector<LightDetection> detections(detections_.begin(), detections_.begin() + 4);
+  detections[3] = detections_[2];
+  detections[3].uv += Eigen::Vector2d(0.0, 8.0);
+  const std::vector<int> ids(ids_.begin(), ids_.begin() + 4);
+  const IdentifiedLightPose pose =
+      PoseFromIdentifiedLights(camera_, dock_, detections, ids, Start(1.0));
   EXPECT_FALSE(pose.T_C_D);
   EXPECT_NE(pose.reason.find("not consistent with one pose"), std::string::npos) << pose.reason;
 }

@@ -9,7 +9,9 @@
 // the covariance widened by the a-posteriori variance factor. Kept when
 //   - at least min_lights are identified (4: 3 lights fit any pose exactly, nothing checks them);
 //   - the residuals are consistent with those covariances: P(chi-square(2 n - 6) > chi2) >=
-//     consistency_alpha (the tracking matcher's test);
+//     consistency_alpha (the tracking matcher's test); while they are not, the light without
+//     which the others fit best (least chi-square) is left out (a glint the walk took for a
+//     light, a centroid pulled by a neighbour's glow), down to min_lights;
 //   - the pose is within max_start_angle_deg of the walk's rotation (the walk's labels came from
 //     its pose: a PnP minimum far from it is not the pose they describe);
 //   - the camera is above the deck (CameraAboveTheDeck, as every pose of MonoLightPoser).
@@ -41,6 +43,8 @@ struct IdentifiedLightPoseOptions {
 
 struct IdentifiedLightPose {
   std::optional<Pose3> T_C_D;
+  // Per detection: the light id the pose used, -1 for one left out or never identified.
+  std::vector<int> light_ids;
   Eigen::Matrix<double, 6, 6> covariance_local = Eigen::Matrix<double, 6, 6>::Zero();
   double rms_px = 0.0;
   double pixel_sigma_px = 0.0;
