@@ -6,9 +6,9 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/core/utils/logger.hpp>
 
 #include "auvdock/io/input_error.h"
 
@@ -138,8 +138,8 @@ bool FootageSource::Next(FootageFrame* frame) {
     last_time_s_ = 0.0;
   } else {
     const double stamped = (time_ms - first_time_ms_) / 1000.0;
-    last_time_s_ = std::isfinite(stamped) && stamped > last_time_s_ ? stamped
-                                                                    : last_time_s_ + interval_s_;
+    last_time_s_ =
+        std::isfinite(stamped) && stamped > last_time_s_ ? stamped : last_time_s_ + interval_s_;
   }
   frame->time_s = last_time_s_;
   ++next_;

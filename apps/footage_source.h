@@ -65,8 +65,8 @@ class FootageSource {
   std::unique_ptr<cv::VideoCapture> video_;
   int announced_ = 0;
   double interval_s_ = 0.0;
-  int next_ = 0;            // index of the next frame Next returns
-  int video_position_ = 0;  // index of the frame the capture reads next
+  int next_ = 0;                // index of the next frame Next returns
+  int video_position_ = 0;      // index of the frame the capture reads next
   double first_time_ms_ = 0.0;  // the first frame's time stamp in the file
   double last_time_s_ = 0.0;    // the time of the frame Next returned last
   bool ended_ = false;

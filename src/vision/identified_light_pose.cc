@@ -2,19 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 #include <stdexcept>
+#include <utility>
 
 #include "auvdock/estimator/adaptive_noise_scale.h"
 #include "auvdock/vision/pnp_solver.h"
 
 namespace auvdock {
 
-IdentifiedLightPose PoseFromIdentifiedLights(const CameraCalibration& camera,
-                                             const DockModel& dock,
+IdentifiedLightPose PoseFromIdentifiedLights(const CameraCalibration& camera, const DockModel& dock,
                                              const std::vector<LightDetection>& detections,
-                                             const std::vector<int>& light_ids,
-                                             const Pose3& start,
+                                             const std::vector<int>& light_ids, const Pose3& start,
                                              const IdentifiedLightPoseOptions& options) {
   if (options.min_lights < 4 || !(options.consistency_alpha > 0.0) ||
       !(options.max_start_angle_deg > 0.0)) {
@@ -47,7 +45,8 @@ IdentifiedLightPose PoseFromIdentifiedLights(const CameraCalibration& camera,
            (pose.dof == 0 || 1.0 - ChiSquareCdf(pose.dof, pose.chi2) >= options.consistency_alpha);
   };
   auto count = [](const std::vector<int>& lights) {
-    return static_cast<int>(std::count_if(lights.begin(), lights.end(), [](int id) { return id >= 0; }));
+    return static_cast<int>(
+        std::count_if(lights.begin(), lights.end(), [](int id) { return id >= 0; }));
   };
   if (count(used) < options.min_lights) {
     result.reason = std::to_string(count(used)) + " identified lights (need " +
@@ -78,15 +77,16 @@ IdentifiedLightPose PoseFromIdentifiedLights(const CameraCalibration& camera,
   if (!consistent(pose)) {
     result.reason = "the " + std::to_string(count(used)) +
                     " identified lights are not consistent with one pose at their pixel noise "
-                    "(chi-square " + std::to_string(std::lround(pose.chi2)) + ", " +
-                    std::to_string(pose.dof) + " degrees of freedom)";
+                    "(chi-square " +
+                    std::to_string(std::lround(pose.chi2)) + ", " + std::to_string(pose.dof) +
+                    " degrees of freedom)";
     return result;
   }
   result.num_lights = count(used);
   const double turn_deg = RotationAngleBetween(pose.T_C_D.q, start.q) * 180.0 / M_PI;
   if (turn_deg > options.max_start_angle_deg) {
-    result.reason = "the pose of the identified lights is " + std::to_string(std::lround(turn_deg)) +
-                    " deg from the walk's";
+    result.reason = "the pose of the identified lights is " +
+                    std::to_string(std::lround(turn_deg)) + " deg from the walk's";
     return result;
   }
   if (!CameraAboveTheDeck(dock, pose.T_C_D, options.deck)) {

@@ -26,8 +26,8 @@ class IdentifiedLightPoseTest : public ::testing::Test {
     std::normal_distribution<double> noise(0.0, 0.3);
     for (const DockLight& light : dock_.lights) {
       LightDetection d;
-      d.uv = *camera_.intrinsics.Project(truth_ * light.p_D) +
-             Eigen::Vector2d(noise(rng), noise(rng));
+      d.uv =
+          *camera_.intrinsics.Project(truth_ * light.p_D) + Eigen::Vector2d(noise(rng), noise(rng));
       d.radius_px = 3.0;
       detections_.push_back(d);
       ids_.push_back(light.id);

@@ -53,11 +53,9 @@ struct IdentifiedLightPose {
 };
 
 // light_ids: per detection, the dock light id or -1; start: the walk's pose of the frame.
-IdentifiedLightPose PoseFromIdentifiedLights(const CameraCalibration& camera,
-                                             const DockModel& dock,
+IdentifiedLightPose PoseFromIdentifiedLights(const CameraCalibration& camera, const DockModel& dock,
                                              const std::vector<LightDetection>& detections,
-                                             const std::vector<int>& light_ids,
-                                             const Pose3& start,
+                                             const std::vector<int>& light_ids, const Pose3& start,
                                              const IdentifiedLightPoseOptions& options = {});
 
 }  // namespace auvdock
