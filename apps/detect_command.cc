@@ -345,11 +345,6 @@ void RunDetect(const DetectOptions& options) {
     record.light_ids = pose.light_ids;
     record.status = pose.T_C_D ? "ok" : MatchStatusName(pose.status);
     record.tracked = pose.tracked;
-    int left_out = 0;
-    for (size_t i = 0; i < record.light_ids.size(); ++i) {
-      left_out += record.light_ids[i] >= 0 && pose.light_ids[i] < 0;
-    }
-    record.light_ids = pose.light_ids;
     record.T_C_D = pose.T_C_D;
     record.covariance_local = pose.covariance_local;
     record.rms_px = pose.rms_px;

@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 namespace auvdock::cli {
 namespace {
 
-// 8-bit, 1 or 3 channels; path names the image in the error.
+// The image as 8-bit, 1 or 3 channels (4 made BGR); origin names it in the error.
 cv::Mat Normalised(cv::Mat image, const std::string& origin) {
   if (image.depth() != CV_8U) throw InputError(origin + ": not an 8-bit image");
   if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);

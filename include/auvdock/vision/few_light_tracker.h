@@ -62,9 +62,10 @@
 //   verdict: a detection outside every in-view light's gate at unexplained_chi2, farther than
 //            unexplained_floor_px from every light and farther than unexplained_spacing_fraction
 //            of each light's distance to its nearest neighbour's projection, is no light of the
-//            dock at this pose, and so is one near lights only that this step labelled with
-//            another detection or candidate (a second detection of a light: a glint beside it) (a fitting or a speck that passed the detector; MonoLightPipeline
-//            step 6 does the same with a pose of the frame's own). The spacing term is the
+//            dock at this pose (a fitting or a speck that passed the detector; MonoLightPipeline
+//            step 6 does the same with a pose of the frame's own); so is a detection near lights
+//            only that this step labelled with another detection or candidate (a second
+//            detection of a light, a glint beside it). The spacing term is the
 //            camera and dock model's error, which the start poses' residual understates for the
 //            lights they did not see: on the real pool clip's poorer model (5-8 px on the
 //            labels) a walk put a LED 19 px from its prediction at a residual of 1.3 px. A frame with detections of which none is labelled
