@@ -585,7 +585,7 @@ void AddDetectCommand(CLI::App& root) {
   CLI::Option* images =
       sub->add_option("--images", options->images, "Image files, a glob pattern: \"DIR/*.jpg\"");
   sub->add_option("--video", options->video,
-                  "A video file instead of --images (what OpenCV's FFmpeg or GStreamer reader "
+                  "A video file instead of --images (what OpenCV's FFmpeg reader "
                   "opens: mp4, avi, mkv, ...); its frames are named frame_000000, frame_000001, "
                   "... in the outputs and the labels")
       ->excludes(images);

@@ -64,17 +64,20 @@ void FootageSource::OpenVideo() {
   setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", /*overwrite=*/0);
   const cv::utils::logging::LogLevel level =
       cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  // Only OpenCV's file readers, FFmpeg first: CAP_ANY would also probe camera backends (DC1394
+  // enumerates the USB devices and leaks what it allocates for them).
   video_ = std::make_unique<cv::VideoCapture>();
-  try {
-    video_->open(video_path_, cv::CAP_ANY);
-  } catch (const cv::Exception& e) {
-    cv::utils::logging::setLogLevel(level);
-    throw InputError("--video: " + video_path_ + ": OpenCV cannot open it (" + e.what() + ")");
+  for (const int reader : {cv::CAP_FFMPEG, cv::CAP_OPENCV_MJPEG}) {
+    try {
+      if (video_->open(video_path_, reader)) break;
+    } catch (const cv::Exception&) {
+      video_->release();
+    }
   }
   cv::utils::logging::setLogLevel(level);
   if (!video_->isOpened()) {
     throw InputError("--video: " + video_path_ +
-                     ": OpenCV's video readers (FFmpeg, GStreamer) cannot open it");
+                     ": OpenCV's video readers (FFmpeg, Motion JPEG) cannot open it");
   }
   video_position_ = 0;
 }

@@ -1,6 +1,6 @@
 // The images that `auvdock detect` looks at, one after the other: either the files that a glob
-// pattern matches (sorted by name) or the frames of a video file (OpenCV's video I/O: FFmpeg or
-// GStreamer, whatever codec they read).
+// pattern matches (sorted by name) or the frames of a video file (OpenCV's video I/O: its FFmpeg
+// reader, whatever codec that reads, else its own Motion JPEG reader).
 //
 // Each frame carries
 //   index   0, 1, 2, ... in the order read;
