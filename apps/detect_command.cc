@@ -5,8 +5,9 @@
 //                [--gravity-camera X Y Z] [--min-halo-excess GRAY]
 //
 // A first look at one's own footage: the real-water light detector, the identification and the
-// mono pose on every image, in name order, or every frame of a video (footage_source.h: frames
-// named frame_NNNNNN, timed by the file's time stamps) (MonoLightPipeline: with a second look for the lights
+// mono pose on every image, in name order, or on every frame of a video (footage_source.h: frames
+// named frame_NNNNNN, timed by the file's time stamps). MonoLightPipeline does each, with a
+// second look for the lights
 // that the first pass missed where the tracked or the new pose puts them, and over the whole image
 // at laxer thresholds when there is no pose; --no-second-look: the first pass only); the halo
 // colour threshold is learned from the identified lights (HaloColourLearner) unless given. The
@@ -128,6 +129,12 @@ void DrawOverlay(const cv::Mat& image, const std::vector<LightDetection>& detect
   cv::imwrite(path, vis);
 }
 
+// A pose's residual per axis, a posteriori: rms_px sqrt(n / (2 n - 6)) for n lights (0 with 3 or
+// fewer: no degrees of freedom left).
+double ResidualSigmaPerAxis(double rms_px, int num_lights) {
+  return num_lights > 3 ? rms_px * std::sqrt(num_lights / (2.0 * num_lights - 6.0)) : 0.0;
+}
+
 struct WalkRevision {
   int refuted = 0, identified = 0, unexplained = 0, accepted = 0;
 };
@@ -137,10 +144,11 @@ struct WalkRevision {
 // light of the dock moves to its rejected candidates (unless keep_unexplained), and a candidate
 // rejected on appearance alone, or a saturated disc, where the walk put a light
 // (FewLightTracker's doubtful candidates) becomes that light's detection. Each says so in its
-// reason.
+// reason; a refuted frame's reason class is counted in no_pose_reasons.
 WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep_unexplained,
                               std::vector<FrameRecord>* records,
-                              std::map<std::string, int>* rejected_reasons) {
+                              std::map<std::string, int>* rejected_reasons,
+                              std::map<std::string, int>* no_pose_reasons) {
   const std::string not_a_light = "not a light of the dock at the neighbouring frames' pose";
   WalkRevision revision;
   for (size_t k = 0; k < records->size(); ++k) {
@@ -158,6 +166,11 @@ WalkRevision ReviseByTheWalks(const std::vector<BridgedFrame>& frames, bool keep
               : "refuted: its tracked pose (" + std::to_string(walked.identified()) +
                     " lights) is refuted by the longer run of poses from frame " + from +
                     ", whose walk labels more of its detections";
+      record.no_pose_class =
+          walked.contradicted > 0
+              ? "refuted: a lone pose whose lights the neighbouring run of poses finds none"
+              : "refuted by a longer run of poses";
+      ++(*no_pose_reasons)[record.no_pose_class];
       record.status = "refuted";
       record.tracked = false;
       record.T_C_D.reset();
@@ -235,8 +248,7 @@ int PoseFromTheWalksLabels(const CameraCalibration& camera, const DockModel& doc
     record.covariance_local = pose.covariance_local;
     record.rms_px = pose.rms_px;
     record.pixel_sigma_px = pose.pixel_sigma_px;
-    record.residual_sigma_px =
-        pose.rms_px * std::sqrt(pose.num_lights / (2.0 * pose.num_lights - 6.0));
+    record.residual_sigma_px = ResidualSigmaPerAxis(pose.rms_px, pose.num_lights);
     record.status = "ok";
     record.tracked = false;
     record.reason = "posed from the " + std::to_string(pose.num_lights) +
@@ -349,10 +361,7 @@ void RunDetect(const DetectOptions& options) {
     record.covariance_local = pose.covariance_local;
     record.rms_px = pose.rms_px;
     record.pixel_sigma_px = pose.pixel_sigma_px;
-    if (pose.T_C_D && pose.num_lights > 3) {
-      record.residual_sigma_px =
-          pose.rms_px * std::sqrt(pose.num_lights / (2.0 * pose.num_lights - 6.0));
-    }
+    if (pose.T_C_D) record.residual_sigma_px = ResidualSigmaPerAxis(pose.rms_px, pose.num_lights);
     record.rejected = std::move(frame.rejected);
     for (const RejectedLightCandidate& r : record.rejected) {
       if (!r.overrulable) continue;
@@ -446,7 +455,7 @@ void RunDetect(const DetectOptions& options) {
     n_bridged = BridgeFramesWithoutPose(camera.intrinsics, dock, footage.frame_interval_s(),
                                         bridge_options, &frames);
     const WalkRevision revision =
-        ReviseByTheWalks(frames, options.keep_unexplained, &records, &rejected_reasons);
+        ReviseByTheWalks(frames, options.keep_unexplained, &records, &rejected_reasons, &reasons);
     n_refuted = revision.refuted;
     n_bridge_identified = revision.identified;
     n_bridge_unexplained = revision.unexplained;
@@ -468,11 +477,6 @@ void RunDetect(const DetectOptions& options) {
   for (const FrameRecord& record : records) {
     n_pose += record.T_C_D.has_value();
     n_tracked += record.T_C_D && record.tracked;
-    if (record.status == "refuted") {
-      ++reasons[record.reason.rfind("refuted: its lone pose", 0) == 0
-                    ? "refuted: a lone pose whose lights the neighbouring run of poses finds none"
-                    : "refuted by a longer run of poses"];
-    }
   }
   int n_detections = 0;
   std::map<std::string, FrameDetections> evaluated;

@@ -42,7 +42,7 @@ struct FrameRecord {
   // image's saturated discs (FindSaturatedDiscs), as detections with their covariance: a walk may
   // find a light there (two_way_light_bridge.h).
   std::vector<LightDetection> doubtful;
-  std::string no_pose_class;  // ReasonClass of the reason of a frame without a pose of its own
+  std::string no_pose_class;  // why a frame has no pose, as counted: ReasonClass, or refuted
 };
 
 class DetectOutput {
