@@ -16,15 +16,17 @@
 
 #include "auvdock/estimator/chain_marginals.h"
 #include "auvdock/estimator/chain_solver.h"
-#include "auvdock/estimator/sensor_factors.h"
 #include "auvdock/estimator/imu_buffer.h"
+#include "auvdock/estimator/sensor_factors.h"
 #include "auvdock/estimator/vision_factors.h"
 #include "factors/bias_prior_factor.h"
-#include "factors/imu_preintegration_factor.h"
 #include "factors/depth_offset_factor.h"
+#include "factors/dvl_factor.h"
+#include "factors/imu_preintegration_factor.h"
 #include "factors/pose_manifold.h"
 #include "factors/pose_prior_factor.h"
 #include "factors/scalar_random_walk_factor.h"
+#include "factors/vector_random_walk_factor.h"
 #include "factors/velocity_prior_factor.h"
 
 namespace auvdock {
@@ -36,6 +38,7 @@ struct BatchState {
   double velocity[kVelocitySize];
   double bias[kBiasSize];
   double depth_offset[kDepthOffsetSize] = {0.0};  // m; a block only with estimate_depth_offset
+  double dvl_bias[kDvlBiasSize] = {0.0, 0.0, 0.0};  // m/s in S; a block only with estimate_dvl_bias
   std::vector<VisionResidual> vision;
   int n_gated = 0;
 };
@@ -53,15 +56,23 @@ class ProgressCallback final : public ceres::IterationCallback {
   const std::function<void(int, double)>& progress_;
 };
 
-// Each state's blocks (pose, velocity, bias, and the depth offset when it is estimated), in
-// time order: the chain of chain_solver.h and chain_marginals.h.
+// Which of the optional blocks every state carries.
+struct OptionalBlocks {
+  bool depth_offset = false;  // EstimatesDepthOffset
+  bool dvl_bias = false;      // EstimatesDvlBias
+};
+
+// Each state's blocks (pose, velocity, bias, the DVL's bias and the depth offset when they are
+// estimated, the depth offset last), in time order: the chain of chain_solver.h and
+// chain_marginals.h.
 std::vector<std::vector<double*>> ChainBlocks(
-    const std::vector<std::unique_ptr<BatchState>>& states, bool with_depth_offset) {
+    const std::vector<std::unique_ptr<BatchState>>& states, const OptionalBlocks& with) {
   std::vector<std::vector<double*>> chain;
   chain.reserve(states.size());
   for (const auto& s : states) {
     chain.push_back({s->pose, s->velocity, s->bias});
-    if (with_depth_offset) chain.back().push_back(s->depth_offset);
+    if (with.dvl_bias) chain.back().push_back(s->dvl_bias);
+    if (with.depth_offset) chain.back().push_back(s->depth_offset);
   }
   return chain;
 }
@@ -79,9 +90,8 @@ struct BatchSolve {
 // general sparse Cholesky; Ceres solves anything else, or everything with chain_solver off.
 BatchSolve SolveBatch(ceres::Problem* problem,
                       const std::vector<std::unique_ptr<BatchState>>& states,
-                      bool with_depth_offset, const ceres::Solver::Options& solver,
-                      const EstimatorOptions& o,
-                      const std::function<void(int, double)>& progress) {
+                      const OptionalBlocks& with, const ceres::Solver::Options& solver,
+                      const EstimatorOptions& o, const std::function<void(int, double)>& progress) {
   BatchSolve result;
   if (o.chain_solver) {
     ChainSolverOptions chain;
@@ -92,7 +102,7 @@ BatchSolve SolveBatch(ceres::Problem* problem,
     chain.initial_lambda = o.solver_initial_damping;
     chain.progress = progress;
     if (const std::optional<ChainSolverSummary> summary =
-            SolveChain(problem, ChainBlocks(states, with_depth_offset), chain)) {
+            SolveChain(problem, ChainBlocks(states, with), chain)) {
       result.initial_cost = summary->initial_cost;
       result.final_cost = summary->final_cost;
       result.iterations = summary->iterations + 1;
@@ -154,11 +164,11 @@ double MedianStateInterval(const std::vector<std::unique_ptr<BatchState>>& state
 // variance (the offset block is a state's last coordinate; NaN where not had).
 std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> PoseMarginals(
     ceres::Problem* problem, const std::vector<std::unique_ptr<BatchState>>& states,
-    bool with_depth_offset, std::vector<double>* offset_variances) {
+    const OptionalBlocks& with, std::vector<double>* offset_variances) {
   std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> marginals(states.size());
   offset_variances->assign(states.size(), std::numeric_limits<double>::quiet_NaN());
   const std::optional<std::vector<std::optional<Eigen::MatrixXd>>> chain_marginals =
-      ChainMarginals(problem, ChainBlocks(states, with_depth_offset));
+      ChainMarginals(problem, ChainBlocks(states, with));
   if (chain_marginals &&
       std::all_of(chain_marginals->begin(), chain_marginals->end(),
                   [](const std::optional<Eigen::MatrixXd>& m) { return m.has_value(); })) {
@@ -166,7 +176,7 @@ std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> PoseMarginals(
       const Eigen::MatrixXd& full = *(*chain_marginals)[k];
       const Eigen::Matrix<double, 6, 6> pose = full.topLeftCorner<6, 6>();
       if (pose.allFinite()) marginals[k] = pose;
-      if (with_depth_offset) (*offset_variances)[k] = full(full.rows() - 1, full.cols() - 1);
+      if (with.depth_offset) (*offset_variances)[k] = full(full.rows() - 1, full.cols() - 1);
     }
     return marginals;
   }
@@ -222,6 +232,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     std::copy(r.velocity, r.velocity + kVelocitySize, s->velocity);
     std::copy(r.bias, r.bias + kBiasSize, s->bias);
     s->depth_offset[0] = r.depth_offset;
+    std::copy(r.dvl_bias, r.dvl_bias + kDvlBiasSize, s->dvl_bias);
     states.push_back(std::move(s));
   }
 
@@ -239,11 +250,28 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   ceres::Problem problem(problem_options);
   const PoseManifold manifold;
   const bool with_depth_offset = EstimatesDepthOffset(estimator_options, calibration);
+  const bool with_dvl_bias = EstimatesDvlBias(estimator_options, calibration);
+  const OptionalBlocks with{with_depth_offset, with_dvl_bias};
   for (size_t k = 0; k < states.size(); ++k) {
     BatchState* s = states[k].get();
     problem.AddParameterBlock(s->pose, kPoseSize, const_cast<PoseManifold*>(&manifold));
     problem.AddParameterBlock(s->velocity, kVelocitySize);
     problem.AddParameterBlock(s->bias, kBiasSize);
+    if (with_dvl_bias) {
+      // The DVL's bias along the whole log, drifting as a random walk; its prior at the start.
+      problem.AddParameterBlock(s->dvl_bias, kDvlBiasSize);
+      if (k == 0) {
+        problem.AddResidualBlock(
+            VectorPriorFactor::Create(Eigen::Vector3d::Zero(),
+                                      estimator_options.dvl_bias_prior_sigma_mps),
+            nullptr, s->dvl_bias);
+      } else {
+        problem.AddResidualBlock(VectorRandomWalkFactor::Create(
+                                     estimator_options.dvl_bias_random_walk,
+                                     1e-9 * static_cast<double>(s->t_ns - states[k - 1]->t_ns)),
+                                 nullptr, states[k - 1]->dvl_bias, s->dvl_bias);
+      }
+    }
     if (with_depth_offset) {
       // One offset along the whole log, drifting as a random walk; its prior at the start.
       problem.AddParameterBlock(s->depth_offset, kDepthOffsetSize);
@@ -264,8 +292,9 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
       const ImuBias bias = BiasFromBlock(p->bias);
       const std::optional<ImuPreintegration> pim = buffer.Preintegrate(p->t_ns, s->t_ns, bias);
       if (pim) {
-        problem.AddResidualBlock(ImuPreintegrationFactor::Create(*pim, dock.gravity_D), nullptr,
-                                 p->pose, p->velocity, p->bias, s->pose, s->velocity, s->bias);
+        problem.AddResidualBlock(
+            ImuPreintegrationFactor::Create(*pim, dock.gravity_D, EarthRate_D(dock)), nullptr,
+            p->pose, p->velocity, p->bias, s->pose, s->velocity, s->bias);
         joined = true;
       }
     }
@@ -291,7 +320,8 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   };
   const auto blocks_of = [&](BatchState* s) {
     return StateBlocks(s->pose, s->velocity, &buffer, BiasFromBlock(s->bias),
-                       with_depth_offset ? s->depth_offset : nullptr);
+                       with_depth_offset ? s->depth_offset : nullptr,
+                       with_dvl_bias ? s->dvl_bias : nullptr);
   };
   std::vector<SensorResidual> depth_residuals;
   if (estimator_options.use_depth && calibration.depth) {
@@ -441,7 +471,8 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     return gate(&sbl_residuals, estimator_options.sbl_gate_chi2, calibration.sbl);
   };
   result.stats.sbl_gated = gate_sbl();
-  BatchSolve summary = SolveBatch(&problem, states, with_depth_offset, solver, estimator_options, options.progress);
+  BatchSolve summary =
+      SolveBatch(&problem, states, with, solver, estimator_options, options.progress);
   result.initial_cost = summary.initial_cost;
   int gated = 0;
   for (auto& s : states) {
@@ -467,7 +498,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   result.stats.sbl_used = static_cast<int>(sbl_residuals.size());
   if (gated > 0 || depth_gated_after > 0 || dvl_gated_after > 0 || usbl_gated_after > 0 ||
       sbl_gated_after > 0 || heading_gated_after > 0) {
-    summary = SolveBatch(&problem, states, with_depth_offset, solver, estimator_options, options.progress);
+    summary = SolveBatch(&problem, states, with, solver, estimator_options, options.progress);
   }
   std::stable_sort(result.rejections.begin(), result.rejections.end(),
                    [](const Rejection& a, const Rejection& b) { return a.t_ns < b.t_ns; });
@@ -484,7 +515,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
 
   std::vector<double> offset_variances;
   const std::vector<std::optional<Eigen::Matrix<double, 6, 6>>> pose_covariances =
-      PoseMarginals(&problem, states, with_depth_offset, &offset_variances);
+      PoseMarginals(&problem, states, with, &offset_variances);
   int64_t last_vision = INT64_MIN;
   std::vector<int64_t> dvl_times;  // of the DVL samples kept, for the go/no-go's DVL age
   for (const SensorResidual& r : dvl_residuals) dvl_times.push_back(r.t_ns);

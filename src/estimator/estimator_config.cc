@@ -33,11 +33,17 @@ RunConfig LoadRunConfig(const std::string& path) {
       est.GetPositive("depth_offset_random_walk", e.depth_offset_random_walk);
   e.use_dvl = est.GetBool("use_dvl", e.use_dvl);
   e.dvl_gate_chi2 = est.GetNonNegative("dvl_gate_chi2", e.dvl_gate_chi2);
+  e.estimate_dvl_bias = est.GetBool("estimate_dvl_bias", e.estimate_dvl_bias);
+  e.dvl_bias_prior_sigma_mps =
+      est.GetPositive("dvl_bias_prior_sigma_mps", e.dvl_bias_prior_sigma_mps);
+  e.dvl_bias_random_walk = est.GetPositive("dvl_bias_random_walk", e.dvl_bias_random_walk);
   e.use_usbl = est.GetBool("use_usbl", e.use_usbl);
   e.usbl_gate_chi2 = est.GetNonNegative("usbl_gate_chi2", e.usbl_gate_chi2);
   e.usbl_rate_test.enabled = est.GetBool("usbl_rate_test", e.usbl_rate_test.enabled);
   e.usbl_rate_test.max_speed_mps =
       est.GetPositive("usbl_rate_max_speed_mps", e.usbl_rate_test.max_speed_mps);
+  e.usbl_rate_test.speed_margin_mps =
+      est.GetNonNegative("usbl_rate_speed_margin_mps", e.usbl_rate_test.speed_margin_mps);
   e.usbl_max_backward_shift_s =
       est.GetNonNegative("usbl_max_backward_shift_s", e.usbl_max_backward_shift_s);
   e.use_sbl = est.GetBool("use_sbl", e.use_sbl);

@@ -81,11 +81,16 @@ std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
       shift ? std::optional<ImuPoseShift>(*shift)
             : ImuShiftFromState(state, t_state_ns, sample.t_ns - t_state_ns, dock.gravity_D);
   if (!own_shift) return std::nullopt;
-  return problem->AddResidualBlock(
-      DvlFactor::Create(sample.v_S, calibration.sigma_mps * std::sqrt(variance_factor),
-                        calibration.T_B_S,
-                        *gyro - state.bias.gyro, *own_shift),
-      HuberOrNone(huber_sigmas), state.pose, state.velocity);
+  const double sigma_mps = calibration.sigma_mps * std::sqrt(variance_factor);
+  if (state.dvl_bias != nullptr) {
+    return problem->AddResidualBlock(
+        DvlFactor::CreateWithBias(sample.v_S, sigma_mps, calibration.T_B_S, *gyro - state.bias.gyro,
+                                  *own_shift),
+        HuberOrNone(huber_sigmas), state.pose, state.velocity, state.dvl_bias);
+  }
+  return problem->AddResidualBlock(DvlFactor::Create(sample.v_S, sigma_mps, calibration.T_B_S,
+                                                     *gyro - state.bias.gyro, *own_shift),
+                                   HuberOrNone(huber_sigmas), state.pose, state.velocity);
 }
 
 std::optional<ceres::ResidualBlockId> AddUsblFactor(ceres::Problem* problem,

@@ -19,11 +19,13 @@
 #include "auvdock/estimator/sensor_factors.h"
 #include "factors/bias_prior_factor.h"
 #include "factors/depth_offset_factor.h"
+#include "factors/dvl_factor.h"
 #include "factors/imu_preintegration_factor.h"
 #include "factors/marginalization_factor.h"
 #include "factors/pose_manifold.h"
 #include "factors/pose_prior_factor.h"
 #include "factors/scalar_random_walk_factor.h"
+#include "factors/vector_random_walk_factor.h"
 #include "factors/velocity_prior_factor.h"
 
 namespace auvdock {
@@ -56,6 +58,7 @@ struct SlidingWindowEstimator::State {
   double velocity[kVelocitySize] = {0, 0, 0};
   double bias[kBiasSize] = {0, 0, 0, 0, 0, 0};
   double depth_offset[kDepthOffsetSize] = {0};  // m; a block only with estimate_depth_offset
+  double dvl_bias[kDvlBiasSize] = {0, 0, 0};    // m/s in S; a block only with estimate_dvl_bias
   std::vector<VisionResidual> vision;  // this frame's vision residuals still in the problem
   int n_gated = 0;
 
@@ -66,6 +69,7 @@ struct SlidingWindowEstimator::State {
     std::copy(velocity, velocity + kVelocitySize, record.velocity);
     std::copy(bias, bias + kBiasSize, record.bias);
     record.depth_offset = depth_offset[0];
+    std::copy(dvl_bias, dvl_bias + kDvlBiasSize, record.dvl_bias);
     return record;
   }
 };
@@ -106,7 +110,9 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
       !(options_.init_velocity_sigma_mps > 0.0) || !(options_.init_gyro_bias_sigma > 0.0) ||
       !(options_.init_accel_bias_sigma > 0.0) ||
       (options_.estimate_depth_offset && (!(options_.depth_offset_prior_sigma_m > 0.0) ||
-                                          !(options_.depth_offset_random_walk > 0.0)))) {
+                                          !(options_.depth_offset_random_walk > 0.0))) ||
+      (options_.estimate_dvl_bias &&
+       (!(options_.dvl_bias_prior_sigma_mps > 0.0) || !(options_.dvl_bias_random_walk > 0.0)))) {
     throw std::invalid_argument("EstimatorOptions: a size, sigma or gate is out of range");
   }
   if (!calibration_.imu) {
@@ -117,6 +123,7 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
   rig_.mono = calibration_.FindCameraByRole(CameraRole::kMono);
   rig_.dock = &dock_;
   depth_offset_on_ = EstimatesDepthOffset(options_, calibration_);
+  dvl_bias_on_ = EstimatesDvlBias(options_, calibration_);
   Reset("");
   stats_.resets = 0;
   stats_.log.clear();
@@ -273,6 +280,12 @@ void SlidingWindowEstimator::StartWindow(const InitialState& initial) {
                              nullptr, state->bias);
   newest_accel_uncertainty_mps2_ = AccelUncertainty(initial.pose_covariance.block<3, 3>(3, 3),
                                                     bias_cov.bottomRightCorner<3, 3>());
+  if (dvl_bias_on_) {
+    problem_->AddParameterBlock(state->dvl_bias, kDvlBiasSize);
+    problem_->AddResidualBlock(
+        VectorPriorFactor::Create(Eigen::Vector3d::Zero(), options_.dvl_bias_prior_sigma_mps),
+        nullptr, state->dvl_bias);
+  }
   if (depth_offset_on_) {
     problem_->AddParameterBlock(state->depth_offset, kDepthOffsetSize);
     problem_->AddResidualBlock(
@@ -295,7 +308,7 @@ bool SlidingWindowEstimator::AddState(int64_t t_ns) {
   nav.q_D_B = previous_pose.q;
   nav.p_D = previous_pose.p;
   nav.v_D = Eigen::Map<const Eigen::Vector3d>(previous.velocity);
-  const NavState predicted = pim->Predict(nav, bias, dock_.gravity_D);
+  const NavState predicted = pim->Predict(nav, bias, dock_.gravity_D, EarthRate_D(dock_));
   PoseToBlock(Pose3(predicted.q_D_B, predicted.p_D), state->pose);
   Eigen::Map<Eigen::Vector3d>(state->velocity) = predicted.v_D;
   std::copy(previous.bias, previous.bias + kBiasSize, state->bias);
@@ -303,9 +316,16 @@ bool SlidingWindowEstimator::AddState(int64_t t_ns) {
   problem_->AddParameterBlock(state->pose, kPoseSize, pose_manifold_.get());
   problem_->AddParameterBlock(state->velocity, kVelocitySize);
   problem_->AddParameterBlock(state->bias, kBiasSize);
-  problem_->AddResidualBlock(ImuPreintegrationFactor::Create(*pim, dock_.gravity_D), nullptr,
-                             previous.pose, previous.velocity, previous.bias, state->pose,
-                             state->velocity, state->bias);
+  problem_->AddResidualBlock(
+      ImuPreintegrationFactor::Create(*pim, dock_.gravity_D, EarthRate_D(dock_)), nullptr,
+      previous.pose, previous.velocity, previous.bias, state->pose, state->velocity, state->bias);
+  if (dvl_bias_on_) {
+    std::copy(previous.dvl_bias, previous.dvl_bias + kDvlBiasSize, state->dvl_bias);
+    problem_->AddParameterBlock(state->dvl_bias, kDvlBiasSize);
+    problem_->AddResidualBlock(VectorRandomWalkFactor::Create(options_.dvl_bias_random_walk,
+                                                              Seconds(t_ns - previous.t_ns)),
+                               nullptr, previous.dvl_bias, state->dvl_bias);
+  }
   if (depth_offset_on_) {
     state->depth_offset[0] = previous.depth_offset[0];
     problem_->AddParameterBlock(state->depth_offset, kDepthOffsetSize);
@@ -330,6 +350,8 @@ bool SlidingWindowEstimator::Solve(bool stop_early) {
     if (summary) return summary->usable;  // else not a chain: Ceres below
   }
   ceres::Solver::Options options;
+  // The same first damping as the chain solver's (Ceres' trust region radius is its inverse).
+  options.initial_trust_region_radius = 1.0 / options_.solver_initial_damping;
   options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
   options.max_num_iterations = options_.max_solver_iterations;
@@ -351,7 +373,9 @@ bool SlidingWindowEstimator::Solve(bool stop_early) {
                                     [](double x) { return std::isfinite(x); }) &&
                         std::all_of(state->bias, state->bias + kBiasSize,
                                     [](double x) { return std::isfinite(x); }) &&
-                        std::isfinite(state->depth_offset[0]);
+                        std::isfinite(state->depth_offset[0]) &&
+                        std::all_of(state->dvl_bias, state->dvl_bias + kDvlBiasSize,
+                                    [](double x) { return std::isfinite(x); });
     if (!finite) return false;
   }
   return true;
@@ -503,6 +527,11 @@ void SlidingWindowEstimator::AddDvl(const DvlMeasurement& sample) {
     return;
   }
   last_dvl_sample_t_ns_ = sample.t_ns;
+  if (window_.empty()) {
+    // Before a start the acoustic rate tests take the vehicle's speed from the DVL.
+    usbl_rate_test_.SetEstimatedSpeed(sample.v_S.norm());
+    for (UsblRateTest& test : sbl_rate_tests_) test.SetEstimatedSpeed(sample.v_S.norm());
+  }
   pending_dvl_.push_back(sample);
   if (options_.acoustic_init.enabled) acoustic_init_.AddDvl(sample);
 }
@@ -525,7 +554,8 @@ double SlidingWindowEstimator::AccelUncertainty(const Eigen::Matrix3d& attitude_
 
 StateBlocks SlidingWindowEstimator::BlocksOf(State& state) const {
   return StateBlocks(state.pose, state.velocity, &imu_, BiasFromBlock(state.bias),
-                     depth_offset_on_ ? state.depth_offset : nullptr);
+                     depth_offset_on_ ? state.depth_offset : nullptr,
+                     dvl_bias_on_ ? state.dvl_bias : nullptr);
 }
 
 SlidingWindowEstimator::State* SlidingWindowEstimator::StateFor(int64_t t_ns,
@@ -671,6 +701,7 @@ void SlidingWindowEstimator::MarginalizeOldest() {
 
 std::vector<double*> SlidingWindowEstimator::ParameterBlocks(State& state) const {
   std::vector<double*> blocks = {state.pose, state.velocity, state.bias};
+  if (dvl_bias_on_) blocks.push_back(state.dvl_bias);
   if (depth_offset_on_) blocks.push_back(state.depth_offset);
   return blocks;
 }
@@ -740,12 +771,11 @@ double SlidingWindowEstimator::DvlAdmissionStatistic(ceres::ResidualBlockId id,
   }
   Eigen::Matrix<double, 3, kPoseTangentSize + kVelocitySize> H =
       Eigen::Matrix<double, 3, kPoseTangentSize + kVelocitySize>::Zero();
-  for (size_t b = 0; b < blocks.size(); ++b) {
-    if (problem_->ParameterBlockSize(blocks[b]) == kPoseSize) {
-      H.leftCols<kPoseTangentSize>() += J[b];
-    } else if (problem_->ParameterBlockSize(blocks[b]) == kVelocitySize) {
-      H.rightCols<kVelocitySize>() += J[b];
-    }
+  // AddDvlFactor's blocks: the pose, the velocity, then the DVL's bias when estimated (its
+  // prior's uncertainty is left out: the admission tests for gross errors, beyond the bias's).
+  if (blocks.size() >= 2) {
+    H.leftCols<kPoseTangentSize>() = J[0];
+    H.rightCols<kVelocitySize>() = J[1];
   }
   const Eigen::Matrix3d S =
       Eigen::Matrix3d::Identity() + H * *newest_pose_velocity_covariance_ * H.transpose();
@@ -893,6 +923,11 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   if (!state->vision.empty()) last_vision_t_ns_ = frame.t_ns;
   while (static_cast<int>(window_.size()) > options_.window_size) MarginalizeOldest();
 
+  // The rate tests of the acoustic measurements bound the vehicle's speed by its estimate.
+  const double speed_mps = Eigen::Map<const Eigen::Vector3d>(state->velocity).norm();
+  usbl_rate_test_.SetEstimatedSpeed(speed_mps);
+  for (UsblRateTest& test : sbl_rate_tests_) test.SetEstimatedSpeed(speed_mps);
+
   EstimatorOutput out = Output(*state);
   out.n_depth = static_cast<int>(depth.size()) + depth_gated;
   out.n_depth_gated = depth_gated;
@@ -949,7 +984,7 @@ std::optional<Pose3> SlidingWindowEstimator::PropagatedPose(int64_t t_ns) const 
   nav.q_D_B = T.q;
   nav.p_D = T.p;
   nav.v_D = Eigen::Map<const Eigen::Vector3d>(newest.velocity);
-  const NavState predicted = pim->Predict(nav, bias, dock_.gravity_D);
+  const NavState predicted = pim->Predict(nav, bias, dock_.gravity_D, EarthRate_D(dock_));
   return Pose3(predicted.q_D_B, predicted.p_D);
 }
 

@@ -31,7 +31,8 @@ UsblRateVerdict UsblRateTest::CheckValue(int64_t t_ns, const Eigen::Vector3d& va
   }
   const double dt = 1e-9 * static_cast<double>(t_ns - reference_->t_ns);
   const double change = (value - reference_->value).norm();
-  verdict.excess = (change - options_.max_speed_mps * dt) / std::hypot(sigma, reference_->sigma);
+  const double speed_bound = speed_bound_mps();
+  verdict.excess = (change - speed_bound * dt) / std::hypot(sigma, reference_->sigma);
   if (verdict.excess <= options_.gate_sigmas) {
     candidate_ = Reference{t_ns, value, sigma, true};
     return verdict;
@@ -43,7 +44,7 @@ UsblRateVerdict UsblRateTest::CheckValue(int64_t t_ns, const Eigen::Vector3d& va
   char reason[160];
   std::snprintf(reason, sizeof(reason),
                 "rate test: %.2f m from the last good %s %.2f s before (at most %.2f m/s)", change,
-                what, dt, options_.max_speed_mps);
+                what, dt, speed_bound);
   verdict.pass = false;
   verdict.reason = reason;
   return verdict;

@@ -31,4 +31,11 @@ const DockLight* DockModel::FindLight(int id) const {
   return nullptr;
 }
 
+Eigen::Vector3d EarthRate_D(const DockModel& dock) {
+  if (!dock.HasLatitude()) return Eigen::Vector3d::Zero();
+  const double c = std::cos(dock.latitude_rad), s = std::sin(dock.latitude_rad);
+  return kEarthRotationRate *
+         Eigen::Vector3d(c * std::cos(dock.heading_rad), -c * std::sin(dock.heading_rad), -s);
+}
+
 }  // namespace auvdock

@@ -154,14 +154,20 @@ void ImuPreintegration::Integrate(const Eigen::Vector3d& gyro_B, const Eigen::Ve
 }
 
 NavState ImuPreintegration::Predict(const NavState& state_i, const ImuBias& bias,
-                                    const Eigen::Vector3d& gravity_D) const {
+                                    const Eigen::Vector3d& gravity_D,
+                                    const Eigen::Vector3d& earth_rate_D) const {
   const CorrectedImuDeltas<double> d = Correct<double>(bias.gyro, bias.accel);
   const Eigen::Quaterniond dq = delta_q_ * ExpQuaternion(d.rotation_correction);
   const double t = sum_dt_;
+  const Eigen::Vector3d& w = earth_rate_D;
+  const Eigen::Vector3d dv_D = state_i.q_D_B * d.delta_v;
+  const Eigen::Vector3d dp_D = state_i.q_D_B * d.delta_p;
   NavState state_j;
-  state_j.q_D_B = (state_i.q_D_B * dq).normalized();
-  state_j.v_D = state_i.v_D + gravity_D * t + state_i.q_D_B * d.delta_v;
-  state_j.p_D = state_i.p_D + state_i.v_D * t + 0.5 * gravity_D * t * t + state_i.q_D_B * d.delta_p;
+  state_j.q_D_B = (ExpQuaternion(Eigen::Vector3d(-w * t)) * state_i.q_D_B * dq).normalized();
+  state_j.p_D = state_i.p_D + state_i.v_D * t + 0.5 * gravity_D * t * t + dp_D -
+                w.cross(dv_D) * (t * t / 6.0) - w.cross(state_i.v_D) * (t * t);
+  state_j.v_D = state_i.v_D + gravity_D * t + dv_D - w.cross(Eigen::Vector3d(t * dv_D - dp_D)) -
+                2.0 * w.cross(Eigen::Vector3d(state_j.p_D - state_i.p_D));
   return state_j;
 }
 

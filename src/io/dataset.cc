@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "auvdock/io/dock_io.h"
+#include "auvdock/io/imu_time_base.h"
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/sensor_csv.h"
 #include "euroc_dataset.h"
@@ -34,6 +35,10 @@ Dataset LoadAuvdockDataset(const fs::path& root, std::vector<std::string>* skipp
   if (ds.calibration.imu) {
     const std::string csv = SensorCsv(root, ds.calibration.imu->name);
     if (!csv.empty()) ds.imu = ReadImuCsv(csv, skipped);
+    if (const std::string problem = ImuTimeBaseProblem(ds.imu, *ds.calibration.imu, csv);
+        !problem.empty()) {
+      throw InputError(problem);
+    }
   }
   if (ds.calibration.depth) {
     const std::string csv = SensorCsv(root, ds.calibration.depth->name);

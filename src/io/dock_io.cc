@@ -31,6 +31,13 @@ DockModel LoadDockModel(const std::string& path) {
   if (!std::isfinite(dock.heading_rad)) root.Fail("heading_deg", "must be finite");
   dock.approach_direction_D =
       root.GetVector<3>("approach_direction_D", dock.approach_direction_D);
+  if (root.Has("latitude_deg")) {
+    const double latitude_deg = root.GetDouble("latitude_deg");
+    if (!(latitude_deg >= -90.0 && latitude_deg <= 90.0)) {
+      root.Fail("latitude_deg", "must be between -90 and 90 degrees");
+    }
+    dock.latitude_rad = latitude_deg * M_PI / 180.0;
+  }
   const ConfigNode deck = root.ChildOrEmpty("deck");
   dock.deck_length_m = deck.GetPositive("length_m", dock.deck_length_m);
   dock.deck_width_m = deck.GetPositive("width_m", dock.deck_width_m);
@@ -73,6 +80,7 @@ void SaveDockModel(const DockModel& dock, const std::string& path) {
   if (dock.approach_direction_D.norm() > 0.0) {
     EmitVector3(out, "approach_direction_D", dock.approach_direction_D);
   }
+  if (dock.HasLatitude()) EmitNumber(out, "latitude_deg", dock.latitude_rad * 180.0 / M_PI);
   out << YAML::Key << "deck" << YAML::Value << YAML::BeginMap;
   EmitNumber(out, "length_m", dock.deck_length_m);
   EmitNumber(out, "width_m", dock.deck_width_m);

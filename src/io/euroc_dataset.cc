@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "auvdock/io/imu_time_base.h"
 #include "auvdock/io/input_error.h"
 #include "auvdock/io/pose_from_config.h"
 #include "auvdock/io/sensor_csv.h"
@@ -108,6 +109,13 @@ Dataset LoadEurocDataset(const std::string& mav_dir, std::vector<std::string>* s
     ds.calibration.imu = ReadEurocImu((imu_dir / "sensor.yaml").string());
   }
   if (fs::exists(imu_dir / "data.csv")) ds.imu = ReadImuCsv((imu_dir / "data.csv").string(), skipped_rows);
+  if (ds.calibration.imu) {
+    if (const std::string problem =
+            ImuTimeBaseProblem(ds.imu, *ds.calibration.imu, (imu_dir / "data.csv").string());
+        !problem.empty()) {
+      throw InputError(problem);
+    }
+  }
 
   const fs::path gt = fs::path(mav_dir) / "state_groundtruth_estimate0" / "data.csv";
   if (fs::exists(gt)) ds.groundtruth = ReadGroundTruthCsv(gt.string());

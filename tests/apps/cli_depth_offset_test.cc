@@ -55,13 +55,15 @@ TEST(DepthOffsetCli, AnOffsetIsWarnedOfOrEstimated) {
       EXPECT_EQ(r.exit_status, 0) << command << ": " << r.err;
       return r;
     };
-    // Taken at its word: most samples gated, and a warning that says what to do.
+    // Taken at its word: a large share of the samples gated (more than the quarter that the
+    // warning takes; the DVL's vertical bias, a state since 2026-12-07, explains part of the
+    // offset as a slow drift at first), and a warning that says what to do.
     const std::string at_word = tmp / (command + "_at_word");
     const auto r1 = run(biased, at_word, false);
     EXPECT_THAT(r1.err, HasSubstr("estimate_depth_offset")) << command;
     const nlohmann::json s1 = Summary(at_word);
-    EXPECT_GT(s1["depth_samples"]["gated"].get<int>(), s1["depth_samples"]["used"].get<int>())
-        << command;
+    const int gated = s1["depth_samples"]["gated"].get<int>();
+    EXPECT_GT(3 * gated, gated + s1["depth_samples"]["used"].get<int>()) << command;
     EXPECT_THAT(s1["warnings"].dump(), HasSubstr("estimate_depth_offset")) << command;
     EXPECT_FALSE(s1.contains("depth_offset")) << command;
 

@@ -114,7 +114,9 @@ TEST_F(DetectionsReplayCli, TheBoundOfEveryPoseBesideTheSmoothersErrors) {
   EXPECT_GE(report.at("bound_n").get<int>(), 110);
   const double ratio =
       report.at("pos_rmse_at_bound_m").get<double>() / report.at("bound_pos_rms_m").get<double>();
-  EXPECT_GT(ratio, 0.3);
+  // 0.24 since the DVL's bias is a state (its prior widens the bound; the simulated DVL has
+  // none, so the smoother does better than the configured model says).
+  EXPECT_GT(ratio, 0.15);
   EXPECT_LT(ratio, 3.0);
 
   const fs::path no_truth = *tmp_ / "no_truth";

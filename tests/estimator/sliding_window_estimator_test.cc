@@ -140,10 +140,10 @@ TEST(SlidingWindowEstimatorTest, RecoversTheTrajectoryFromPerturbedInitialPoses)
 }
 
 // The window's own chain solver (EstimatorOptions::chain_solver) against Ceres on the same run:
-// started at Ceres' damping (the default) it takes Ceres' steps (the same estimates to a
-// hundredth of a mm); started at 1e-8 it converges in fewer steps to estimates within a
-// fraction of their standard deviation of Ceres', as accurate and as consistent on this part of
-// the run (lights in view).
+// started at the same damping (the default, 1e-8; Ceres' trust region its inverse) it takes
+// Ceres' steps (the same estimates to a hundredth of a mm); started at Ceres' own damping
+// (1e-4) it stops after a few small steps within a fraction of the estimates' standard deviation
+// of the converged ones, as accurate and as consistent on this part of the run (lights in view).
 TEST(SlidingWindowEstimatorTest, TheChainSolverAgreesWithCeres) {
   const test::SyntheticRun run = MakeRun(1);
   auto outputs = [&](const EstimatorOptions& options, RunErrors* errors) {
@@ -162,12 +162,12 @@ TEST(SlidingWindowEstimatorTest, TheChainSolverAgreesWithCeres) {
   };
   EstimatorOptions ceres;
   ceres.chain_solver = false;
-  EstimatorOptions small_damping;
-  small_damping.solver_initial_damping = 1e-8;
+  EstimatorOptions large_damping;  // Ceres' own first damping, the default until 2026-12-07
+  large_damping.solver_initial_damping = 1e-4;
   RunErrors ceres_errors, same_errors, chain_errors;
   const auto reference = outputs(ceres, &ceres_errors);
   const auto same = outputs(EstimatorOptions(), &same_errors);
-  const auto chain = outputs(small_damping, &chain_errors);
+  const auto chain = outputs(large_damping, &chain_errors);
   ASSERT_EQ(reference.size(), chain.size());
   double same_max_m = 0.0, chain_max_sigmas = 0.0;
   int compared = 0;
@@ -182,13 +182,15 @@ TEST(SlidingWindowEstimatorTest, TheChainSolverAgreesWithCeres) {
     ++compared;
   }
   std::printf(
-      "chain at Ceres' damping: %.2e m from Ceres at most; at 1e-8: %.3f sigma; RMSE %.2f / %.2f "
-      "mm, NEES %.2f / %.2f\n",
+      "chain at the same damping: %.2e m from Ceres at most; at 1e-4: %.3f sigma; RMSE %.2f / "
+      "%.2f mm, NEES %.2f / %.2f\n",
       same_max_m, chain_max_sigmas, 1e3 * ceres_errors.position_rms(),
       1e3 * chain_errors.position_rms(), ceres_errors.nees_sum / ceres_errors.nees_count,
       chain_errors.nees_sum / chain_errors.nees_count);
   EXPECT_GT(compared, 130);
-  EXPECT_LT(same_max_m, 1e-4);  // rounding: the two factorisations differ (measured 5e-6 m)
+  // The two factorisations differ by rounding, and at 1e-8 a step more or less before the early
+  // stop shows: measured 1.3e-4 m (5e-6 m when both started at 1e-4), against errors of ~10 mm.
+  EXPECT_LT(same_max_m, 5e-4);
   EXPECT_LT(chain_max_sigmas, 0.75);  // both stop short of full convergence (measured 0.47)
   EXPECT_LT(chain_errors.position_rms(), 1.1 * ceres_errors.position_rms());
   EXPECT_NEAR(chain_errors.nees_sum / chain_errors.nees_count,

@@ -34,6 +34,32 @@ TEST(UsblRateTest, AJumpFasterThanTheVehicleFailsAgainstAConfirmedReference) {
   EXPECT_TRUE(test.Check(Fix(3.0, -6.5)).pass);  // 1.0 m in 2 s from the reference
 }
 
+// A survey AUV at 2.2 m/s: against the docking bound (1.5 m/s) its good fixes fail; once the
+// estimator gives the test the vehicle's speed the bound is that speed plus the margin
+// (0.5 m/s), and they pass, while a jump faster than that still fails. A slower estimate never
+// lowers the bound below max_speed_mps.
+TEST(UsblRateTest, TheSpeedBoundFollowsTheEstimatedSpeed) {
+  UsblRateTest test;
+  EXPECT_TRUE(test.Check(Fix(0.0, -80.0)).pass);
+  test.Confirm(Fix(0.0, -80.0).t_ns);
+  EXPECT_TRUE(test.Check(Fix(1.0, -78.5)).pass);  // 1.5 m/s: the reference is confirmed
+  test.Confirm(Fix(1.0, -78.5).t_ns);
+  EXPECT_FALSE(test.Check(Fix(2.0, -76.3)).pass);  // 2.2 m in 1 s against 1.5 m/s + 3 sigma
+  test.SetEstimatedSpeed(2.2);
+  EXPECT_DOUBLE_EQ(test.speed_bound_mps(), 2.7);
+  const UsblRateVerdict good = test.Check(Fix(2.0, -76.3));
+  EXPECT_TRUE(good.pass);
+  EXPECT_NEAR(good.excess, (2.2 - 2.7) / (0.1 * std::sqrt(2.0)), 1e-9);
+  test.Confirm(Fix(2.0, -76.3).t_ns);
+  const UsblRateVerdict jump = test.Check(Fix(3.0, -72.8));  // 3.5 m in 1 s
+  EXPECT_FALSE(jump.pass);
+  EXPECT_NE(jump.reason.find("at most 2.70 m/s"), std::string::npos) << jump.reason;
+  test.SetEstimatedSpeed(0.2);
+  EXPECT_DOUBLE_EQ(test.speed_bound_mps(), 1.5);
+  test.SetEstimatedSpeed(std::nan(""));
+  EXPECT_DOUBLE_EQ(test.speed_bound_mps(), 1.5);
+}
+
 // An outlier as the first fix: the test has no opinion on the next one (the reference never
 // passed itself), so a good fix is not rejected against it and the test does not lock.
 TEST(UsblRateTest, AnOutlierAsTheFirstFixDoesNotLockTheTest) {

@@ -129,6 +129,46 @@ TEST(DvlFactorTest, JacobiansPassTheGradientCheckerWithThePoseManifold) {
   EXPECT_LT(results.local_jacobians[0].leftCols<3>().norm(), 1e-12);
 }
 
+// The DVL's bias: a measurement 2 cm/s too fast along the sensor's x is explained by a bias of
+// (0.02, 0, 0) in S (zero residual), and a bias the measurement does not have shows as its own
+// whitened error.
+TEST(DvlFactorTest, ABiasInTheSensorFrameExplainsAMeasurementOffByIt) {
+  const ConstantMotion m;
+  const Pose3 T_B_S = DvlMounting();
+  double pose[kPoseSize], velocity[kVelocitySize];
+  SetStateBlocks(m, pose, velocity);
+  const Eigen::Vector3d v_S = m.DvlVelocity(0.0, T_B_S);
+  const DvlFactor factor(v_S + Eigen::Vector3d(0.02, 0.0, 0.0), 0.01, T_B_S, m.w_B);
+  double r[3];
+  const double bias[3] = {0.02, 0.0, 0.0};
+  ASSERT_TRUE(factor(pose, velocity, bias, r));
+  EXPECT_LT(Eigen::Map<Eigen::Vector3d>(r).norm(), 1e-12);
+  const double other[3] = {0.02, 0.01, -0.03};
+  ASSERT_TRUE(factor(pose, velocity, other, r));
+  EXPECT_NEAR(r[0], 0.0, 1e-9);
+  EXPECT_NEAR(r[1], 1.0, 1e-9);
+  EXPECT_NEAR(r[2], -3.0, 1e-9);
+}
+
+TEST(DvlFactorTest, TheBiasedFactorsJacobiansPassTheGradientChecker) {
+  const ConstantMotion m;
+  const Pose3 T_B_S = DvlMounting();
+  std::unique_ptr<ceres::CostFunction> cost(
+      DvlFactor::CreateWithBias(m.DvlVelocity(0.1, T_B_S) + Eigen::Vector3d(0.02, -0.01, 0.03),
+                                0.01, T_B_S, m.w_B, ShiftFromImu(m, 0.1, 50)));
+  const PoseManifold manifold;
+  std::vector<const ceres::Manifold*> manifolds = {&manifold, nullptr, nullptr};
+  const ceres::GradientChecker checker(cost.get(), &manifolds, ceres::NumericDiffOptions());
+  double pose[kPoseSize], velocity[kVelocitySize];
+  SetStateBlocks(m, pose, velocity);
+  const double bias[3] = {0.01, -0.02, 0.005};
+  const double* parameters[3] = {pose, velocity, bias};
+  ceres::GradientChecker::ProbeResults results;
+  EXPECT_TRUE(checker.Probe(parameters, 1e-7, &results)) << results.error_log;
+  // d r / d b_S = I / sigma.
+  EXPECT_LT((results.local_jacobians[2] * 0.01 - Eigen::Matrix3d::Identity()).norm(), 1e-9);
+}
+
 TEST(DvlFactorTest, RejectsBadInput) {
   const Pose3 T_B_S = DvlMounting();
   const Eigen::Vector3d w = Eigen::Vector3d::Zero();

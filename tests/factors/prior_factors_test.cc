@@ -13,6 +13,7 @@
 #include "factors/pose_manifold.h"
 #include "factors/pose_prior_factor.h"
 #include "factors/scalar_random_walk_factor.h"
+#include "factors/vector_random_walk_factor.h"
 #include "factors/velocity_prior_factor.h"
 
 namespace auvdock {
@@ -213,6 +214,26 @@ TEST(ScalarRandomWalkFactorTest, KnownAnswersAndBadInput) {
   EXPECT_THROW(ScalarRandomWalkFactor(std::nan(""), 1.0), std::invalid_argument);
   EXPECT_THROW(ScalarPriorFactor(std::nan(""), 1.0), std::invalid_argument);
   EXPECT_THROW(ScalarPriorFactor(0.0, -1.0), std::invalid_argument);
+}
+
+TEST(VectorRandomWalkFactorTest, KnownAnswersAndBadInput) {
+  const VectorRandomWalkFactor walk(0.001, 4.0);  // sigma 0.002 per axis over 4 s
+  EXPECT_DOUBLE_EQ(walk.sigma(), 0.002);
+  const double a[3] = {0.1, -0.2, 0.0}, b[3] = {0.104, -0.201, 0.0};
+  double r[3];
+  ASSERT_TRUE(walk(a, b, r));
+  EXPECT_NEAR(r[0], 2.0, 1e-12);
+  EXPECT_NEAR(r[1], -0.5, 1e-12);
+  EXPECT_NEAR(r[2], 0.0, 1e-12);
+  const VectorPriorFactor prior(Eigen::Vector3d(0.1, 0.0, 0.0), 0.5);
+  ASSERT_TRUE(prior(b, r));
+  EXPECT_NEAR(r[0], 0.008, 1e-12);
+  EXPECT_NEAR(r[1], -0.402, 1e-12);
+  EXPECT_NEAR(r[2], 0.0, 1e-12);
+  EXPECT_THROW(VectorRandomWalkFactor(0.0, 1.0), std::invalid_argument);
+  EXPECT_THROW(VectorRandomWalkFactor(0.001, -1.0), std::invalid_argument);
+  EXPECT_THROW(VectorPriorFactor(Eigen::Vector3d(std::nan(""), 0, 0), 1.0), std::invalid_argument);
+  EXPECT_THROW(VectorPriorFactor(Eigen::Vector3d::Zero(), 0.0), std::invalid_argument);
 }
 
 }  // namespace

@@ -1,7 +1,10 @@
 // Bad input in scenario, calibration and dock files: one error naming the file and the key.
+#include <cmath>
+
 #include <gtest/gtest.h>
 #include <gmock/gmock.h>
 
+#include "auvdock/geometry/dock_model.h"
 #include "auvdock/io/calibration.h"
 #include "auvdock/io/dock_io.h"
 #include "auvdock/io/input_error.h"
@@ -123,6 +126,35 @@ TEST_F(ScenarioErrors, BadDockFileNamesTheDockFileAndKey) {
                       "  - {id: 1, p_D: [1, 0, 0]}\n  - {id: 2, p_D: [1, 1, 0]}\n");
   EXPECT_THAT(ErrorOf([&] { LoadDockModel(dock); }),
               AllOf(HasSubstr(dock), HasSubstr("colour"), HasSubstr("purple")));
+  const std::string three_lights =
+      "lights:\n  - {id: 0, p_D: [0, 0, 0]}\n  - {id: 1, p_D: [1, 0, 0]}\n"
+      "  - {id: 2, p_D: [1, 1, 0]}\n";
+  test::WriteTextFile(dock, "name: bad\nlatitude_deg: 132.85\n" + three_lights);
+  EXPECT_THAT(ErrorOf([&] { LoadDockModel(dock); }),
+              AllOf(HasSubstr(dock), HasSubstr("latitude_deg"), HasSubstr("between -90 and 90")));
+}
+
+// The site's latitude: absent, no Earth's rotation; given, read, written back, and the rate in D.
+TEST_F(ScenarioErrors, TheDocksLatitudeIsReadAndWrittenBack) {
+  const std::string path = tmp_ / "docks/lat.yaml";
+  const std::string three_lights =
+      "lights:\n  - {id: 0, p_D: [0, 0, 0]}\n  - {id: 1, p_D: [1, 0, 0]}\n"
+      "  - {id: 2, p_D: [1, 1, 0]}\n";
+  test::WriteTextFile(path, "name: plain\n" + three_lights);
+  const DockModel plain = LoadDockModel(path);
+  EXPECT_FALSE(plain.HasLatitude());
+  EXPECT_EQ(EarthRate_D(plain), Eigen::Vector3d::Zero());
+  test::WriteTextFile(path, "name: haifa\nlatitude_deg: 32.85\nheading_deg: 90\n" + three_lights);
+  const DockModel haifa = LoadDockModel(path);
+  ASSERT_TRUE(haifa.HasLatitude());
+  EXPECT_NEAR(haifa.latitude_rad, 32.85 * M_PI / 180.0, 1e-15);
+  // D's x points east: the north component lies along -y.
+  const Eigen::Vector3d w = EarthRate_D(haifa);
+  EXPECT_NEAR(w.x(), 0.0, 1e-18);
+  EXPECT_NEAR(w.y(), -kEarthRotationRate * std::cos(haifa.latitude_rad), 1e-18);
+  EXPECT_NEAR(w.z(), -kEarthRotationRate * std::sin(haifa.latitude_rad), 1e-18);
+  SaveDockModel(haifa, tmp_ / "docks/lat_out.yaml");
+  EXPECT_NEAR(LoadDockModel(tmp_ / "docks/lat_out.yaml").latitude_rad, haifa.latitude_rad, 1e-12);
 }
 
 TEST(CalibrationErrors, BadRotationAndMissingKey) {

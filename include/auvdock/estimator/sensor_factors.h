@@ -65,7 +65,9 @@ std::optional<ceres::ResidualBlockId> AddHeadingFactor(ceres::Problem* problem,
 // that is not finite (bottom lock lost) is no measurement.
 // shift: the IMU's motion from the state to the sample when the caller has it already
 // (ImuShiftFromState), else it is computed here. variance_factor multiplies the configured
-// variance (the adaptive estimate of the DVL's effective noise, adaptive_noise_scale.h).
+// variance (the adaptive estimate of the DVL's effective noise, adaptive_noise_scale.h). With the
+// state's DVL-bias block (StateBlocks::dvl_bias) the residual carries the bias (on the pose,
+// velocity and bias blocks).
 std::optional<ceres::ResidualBlockId> AddDvlFactor(ceres::Problem* problem,
                                                    const DvlMeasurement& sample,
                                                    const DvlCalibration& calibration,

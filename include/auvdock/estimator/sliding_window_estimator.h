@@ -111,8 +111,13 @@ struct EstimatorOptions {
   // depth sensor). A smaller start (1e-8) converges in 2 steps instead of 6 and is as accurate
   // wherever the depth sensor or the DVL observes those directions, but with vision and IMU
   // alone the converged window drifts further along them (the damping had held them at the
-  // IMU's prediction): measured in the README ("Speed").
-  double solver_initial_damping = 1e-4;
+  // IMU's prediction): measured in the README ("Speed"). 1e-8 since 2026-12-07: that hold is
+  // the damping acting as a prior that no factor states, and the marginalisation then keeps the
+  // unconverged window as if it were the minimum. On a real AUV's IMU, DVL and fixes (A-KIT,
+  // README "Real navigation sensors"), where the DVL's slowly varying bias is such a weakly
+  // observed direction, the window at 1e-4 stopped short along it frame after frame and diverged
+  // (16 m off, 156 of 396 fixes refused); at 1e-8, or at 1e-4 solved to convergence, 0.45 m.
+  double solver_initial_damping = 1e-8;
   VisionFactorOptions vision;           // mono/stereo on/off, Huber threshold, stage weights
   // Chi-square gates on the squared Mahalanobis distance of each vision residual after the
   // solve (p = 0.999: 13.82 for a pixel pair, 16.27 for a 3-D point); 0 = no gating.
@@ -205,6 +210,20 @@ struct EstimatorOptions {
   // that is not finite is bottom lock lost: no measurement, counted apart.
   bool use_dvl = true;
   double dvl_gate_chi2 = 16.27;
+  // The DVL's slowly varying error as a state (factors/dvl_factor.h): a bias b_S (m/s, in the
+  // DVL's frame) per window state, a random walk of dvl_bias_random_walk (m/s/sqrt(s), per axis)
+  // between neighbours, a prior of dvl_bias_prior_sigma_mps about 0 at the window's start.
+  // Why: a real DVL's bottom-track velocity is off by more than its white noise for tens of
+  // seconds at a time: its scale (0.2-0.5 % of the speed), a mounting misalignment (0.5 deg is
+  // 1.7 cm/s across track at 2 m/s), the seabed. Taken as white noise, averaged by the IMU between
+  // samples, it made the window 10x overconfident on a real AUV (A-KIT, README "Real navigation
+  // sensors"). The prior (2 cm/s: 1 % of 2 m/s) and the walk (1 mm/s/sqrt(s): a centimetre per
+  // 100 s) are the datasheet's long-term accuracy (RDI Workhorse: 0.2-0.4 % +- 1-2 mm/s) with a
+  // margin, not a fit. The acoustic fixes and the lights observe b_S; without them its sigma grows
+  // and so does the position's. Off: the DVL's errors are white.
+  bool estimate_dvl_bias = true;
+  double dvl_bias_prior_sigma_mps = 0.02;
+  double dvl_bias_random_walk = 0.001;
   // Acoustic (USBL) fixes of the transponder (the same, needs the calibration's acoustic
   // sensor): 3 dof, p = 0.999, with each fix's own sigma.
   bool use_usbl = true;
@@ -282,6 +301,12 @@ struct EstimatorOptions {
 // use and a depth sensor in the calibration): the window and the batch smoother alike.
 inline bool EstimatesDepthOffset(const EstimatorOptions& options, const Calibration& calibration) {
   return options.estimate_depth_offset && options.use_depth && calibration.depth.has_value();
+}
+
+// Whether the states carry the DVL's bias (estimate_dvl_bias, with the DVL in use and one in the
+// calibration): the window and the batch smoother alike.
+inline bool EstimatesDvlBias(const EstimatorOptions& options, const Calibration& calibration) {
+  return options.estimate_dvl_bias && options.use_dvl && calibration.dvl.has_value();
 }
 
 // The estimate at one state.
@@ -363,6 +388,7 @@ struct StateRecord {
   double velocity[3];
   double bias[6];
   double depth_offset = 0.0;  // m (0 when not estimated)
+  double dvl_bias[3] = {0.0, 0.0, 0.0};  // m/s in the DVL's frame (0 when not estimated)
 };
 
 class SlidingWindowEstimator {
@@ -425,7 +451,8 @@ class SlidingWindowEstimator {
   // stop_early: stop once a step lowers the cost by less than solver_cost_tolerance. The chain
   // solver when the window is a chain and chain_solver is on, Ceres otherwise.
   bool Solve(bool stop_early = true);
-  // One state's parameter blocks: pose, velocity, bias, and the depth offset when estimated.
+  // One state's parameter blocks: pose, velocity, bias, the DVL's bias and the depth offset when
+  // estimated (the depth offset last).
   std::vector<double*> ParameterBlocks(State& state) const;
   // Each window state's blocks (ParameterBlocks), oldest first.
   std::vector<std::vector<double*>> StateBlocksInOrder() const;
@@ -519,6 +546,8 @@ class SlidingWindowEstimator {
   double newest_accel_uncertainty_mps2_ = 0.0;
   // estimate_depth_offset with a depth sensor in use: every state has its offset block.
   bool depth_offset_on_ = false;
+  // estimate_dvl_bias with a DVL in use: every state has its DVL-bias block.
+  bool dvl_bias_on_ = false;
   std::string init_refusal_;
   EstimatorStats stats_;
   // Per light id: the adaptive variance factors of its mono pixels and its stereo points.

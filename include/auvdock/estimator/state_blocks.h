@@ -28,18 +28,24 @@ namespace auvdock {
 // The pose block (factors/pose_manifold.h) and, for measurements after the state's time, its
 // velocity block, the IMU and the bias to preintegrate at. velocity and imu may be null for a
 // measurement at the state's own time. depth_offset: the state's depth-sensor offset block
-// (factors/depth_offset_factor.h) when the estimator estimates one, else null.
+// (factors/depth_offset_factor.h) when the estimator estimates one, else null. dvl_bias: the
+// state's DVL-bias block (factors/dvl_factor.h) when the estimator estimates one, else null.
 struct StateBlocks {
   explicit StateBlocks(double* pose_block, double* velocity_block = nullptr,
                        const ImuBuffer* imu_buffer = nullptr, const ImuBias& state_bias = {},
-                       double* depth_offset_block = nullptr)
-      : pose(pose_block), velocity(velocity_block), imu(imu_buffer), bias(state_bias),
-        depth_offset(depth_offset_block) {}
+                       double* depth_offset_block = nullptr, double* dvl_bias_block = nullptr)
+      : pose(pose_block),
+        velocity(velocity_block),
+        imu(imu_buffer),
+        bias(state_bias),
+        depth_offset(depth_offset_block),
+        dvl_bias(dvl_bias_block) {}
   double* pose;
   double* velocity;
   const ImuBuffer* imu;
   ImuBias bias;
   double* depth_offset;
+  double* dvl_bias;
 };
 
 // The IMU's motion from the state's time t_state_ns to dt_ns later (dt_ns < 0: earlier, a late

@@ -13,9 +13,15 @@
 // passed a test itself, or without a reference (the first fix, or the last good one older than
 // max_reference_age_s), the test has no opinion: the fix goes to the gate, and one bad first fix
 // does not lock the test (the DVL's rate test, dvl_rate_test.h, works the same way).
+// The speed bound is the vehicle's own: max_speed_mps, or more when the estimator knows the
+// vehicle goes faster (SetEstimatedSpeed: its speed over ground plus speed_margin_mps, for the
+// speed it may gain between the reference and the fix). A survey AUV at 1.8-2 m/s is not a
+// docking vehicle at 0.5 m/s, and its good fixes must pass.
 // Units: m, s.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -29,6 +35,7 @@ namespace auvdock {
 struct UsblRateTestOptions {
   bool enabled = true;
   double max_speed_mps = 1.5;        // the vehicle's top speed over ground, with a margin
+  double speed_margin_mps = 0.5;     // above the estimated speed (SetEstimatedSpeed)
   double gate_sigmas = 3.0;
   double max_reference_age_s = 10.0;
 };
@@ -47,6 +54,14 @@ class UsblRateTest {
   UsblRateVerdict Check(const SblRange& range);
   // The candidate at t_ns was kept by the estimator's gate: it becomes the reference.
   void Confirm(int64_t t_ns);
+  // The vehicle's estimated speed over ground (m/s): the bound becomes the larger of
+  // max_speed_mps and speed + speed_margin_mps. A speed that is not finite is ignored.
+  void SetEstimatedSpeed(double speed_mps) {
+    if (std::isfinite(speed_mps)) estimated_speed_mps_ = std::max(0.0, speed_mps);
+  }
+  double speed_bound_mps() const {
+    return std::max(options_.max_speed_mps, estimated_speed_mps_ + options_.speed_margin_mps);
+  }
   void Reset() {
     reference_.reset();
     candidate_.reset();
@@ -63,6 +78,7 @@ class UsblRateTest {
   UsblRateVerdict CheckValue(int64_t t_ns, const Eigen::Vector3d& value, double sigma,
                              const char* what);
   UsblRateTestOptions options_;
+  double estimated_speed_mps_ = 0.0;
   std::optional<Reference> reference_, candidate_;
 };
 

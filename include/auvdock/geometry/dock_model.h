@@ -10,6 +10,8 @@
 // the centre line over 2.8 m (degenerate for a 6-DoF pose: roll about the line is unobservable).
 #pragma once
 
+#include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -42,6 +44,10 @@ struct DockModel {
   // (HeadingMeasurement: clockwise from the heading reference seen from above), when surveyed;
   // a heading factor needs it. dock.yaml: heading_deg.
   double heading_rad = 0.0;
+  // The site's geodetic latitude (rad; dock.yaml: latitude_deg), for the Earth's rotation that a
+  // navigation-grade gyro measures (EarthRate_D); NaN when not given: the Earth's rotation is then
+  // not modelled (right for a MEMS gyro, whose noise hides it).
+  double latitude_rad = std::numeric_limits<double>::quiet_NaN();
   // Acoustic (USBL/SBL) beacon / transponder position on the platform.
   Eigen::Vector3d p_D_beacon = Eigen::Vector3d::Zero();
   // Where vehicles come from, seen from the dock (any length, D frame; e.g. (-1, 0, -1): from
@@ -49,9 +55,22 @@ struct DockModel {
   // layout's poses apart (dock_symmetry.h); zero: unknown.
   Eigen::Vector3d approach_direction_D = Eigen::Vector3d::Zero();
 
+  // Whether latitude_rad is given (the Earth's rotation is modelled).
+  bool HasLatitude() const { return std::isfinite(latitude_rad); }
+
   // True when every light lies within tolerance_m of one line (pose about it unobservable).
   bool LightsCollinear(double tolerance_m = 1e-3) const;
   const DockLight* FindLight(int id) const;
 };
+
+// The Earth's rotation rate in D (rad/s): in the local north-east-down frame N it is
+// Omega (cos lat, 0, -sin lat), Omega = 7.292115e-5 rad/s (WGS-84); D is N turned about down by
+// the dock's heading_rad (D's x axis psi clockwise from north), so
+//   w_ie_D = Omega (cos lat cos psi, -cos lat sin psi, -sin lat).
+// D is fixed to the Earth, so this is also the rate at which D turns against inertial space.
+// heading_rad is taken as from true north (a magnetic declination of a few degrees changes the
+// horizontal part by that angle: 5e-6 rad/s at most). Zero without a latitude.
+Eigen::Vector3d EarthRate_D(const DockModel& dock);
+inline constexpr double kEarthRotationRate = 7.292115e-5;  // rad/s, WGS-84
 
 }  // namespace auvdock

@@ -99,9 +99,13 @@ class ImuPreintegration {
   const ImuBias& linearization_bias() const { return linearization_bias_; }
   const ImuNoiseDensities& noise() const { return noise_; }
 
-  // State j predicted from state i with the bias `bias` (first-order corrected deltas).
-  NavState Predict(const NavState& state_i, const ImuBias& bias,
-                   const Eigen::Vector3d& gravity_D) const;
+  // State j predicted from state i with the bias `bias` (first-order corrected deltas). With
+  // the Earth's rotation earth_rate_D (zero: none), to first order in it, as the IMU factor
+  // models it (factors/imu_preintegration_factor.h): R_j = Exp(-w dt) R_i dR(b),
+  // p_j = p_i + v_i dt + 1/2 g dt^2 + R_i dp(b) - w x R_i dv(b) dt^2 / 6 - w x v_i dt^2,
+  // v_j = v_i + g dt + R_i dv(b) - w x R_i (dt dv(b) - dp(b)) - 2 w x (p_j - p_i).
+  NavState Predict(const NavState& state_i, const ImuBias& bias, const Eigen::Vector3d& gravity_D,
+                   const Eigen::Vector3d& earth_rate_D = Eigen::Vector3d::Zero()) const;
 
   // The deltas corrected to the bias (b_g, b_a) to first order; T is double or a ceres::Jet.
   // The constant terms stay double (mixed double-Jet products, which ceres/jet.h enables for
