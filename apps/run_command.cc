@@ -20,6 +20,7 @@
 #include "apps/signal_flag.h"
 #include "apps/vision_frame_source.h"
 #include "auvdock/estimator/estimator_config.h"
+#include "auvdock/estimator/start_state.h"
 #include "auvdock/io/dataset.h"
 #include "auvdock/io/input_error.h"
 
@@ -31,6 +32,7 @@ struct RunOptions {
   std::string dock;  // --dock: replaces the dataset's dock.yaml
   std::string out;
   std::string config;
+  std::string start;  // --start: a starting state (estimator/start_state.h)
   bool quiet = false;
   bool euroc_csv = false;  // --euroc-csv: also estimate.csv (estimate_writer.h)
   FrameSourceOptions frames;  // --detector, --sync-tolerance-ms, --detections
@@ -47,6 +49,7 @@ void Run(const RunOptions& options) {
   if (!dataset.calibration.imu) throw InputError(options.dataset + ": calibration has no IMU");
   VisionFrameSource source(dataset, options.frames);
   SlidingWindowEstimator estimator(dataset.calibration, RequireDock(dataset), config.estimator);
+  if (!options.start.empty()) estimator.SetStartState(LoadStartState(options.start));
   GoNoGo go_no_go(config.go_no_go);
   EstimateWriter writer(options.out, options.euroc_csv);
   PrintSkippedRows("run", skipped_rows);
@@ -127,6 +130,9 @@ void AddRunCommand(CLI::App& root) {
   AddDockOption(sub, &options->dock);
   sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
   sub->add_option("--config", options->config, "Estimator and go/no-go options (YAML)");
+  sub->add_option("--start", options->start,
+                  "A starting state (YAML: t_ns, p_D, rpy_deg, v_D and their sigmas; an INS's "
+                  "output, a surveyed launch): the window starts from it");
   AddFrameSourceOptions(sub, &options->frames,
                         "Replay these light detections (detections.csv: `simulate` with "
                         "render_images false, `frontend`, or a detector of your own) instead of "

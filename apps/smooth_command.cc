@@ -21,6 +21,7 @@
 #include "apps/vision_frame_source.h"
 #include "auvdock/estimator/batch_smoother.h"
 #include "auvdock/estimator/estimator_config.h"
+#include "auvdock/estimator/start_state.h"
 #include "auvdock/io/dataset.h"
 #include "auvdock/io/input_error.h"
 
@@ -32,6 +33,7 @@ struct SmoothOptions {
   std::string dock;  // --dock: replaces the dataset's dock.yaml
   std::string out;
   std::string config;
+  std::string start;  // --start: a starting state (estimator/start_state.h)
   bool quiet = false;
   bool euroc_csv = false;  // --euroc-csv: also estimate.csv (estimate_writer.h)
   FrameSourceOptions frames;  // --detector, --sync-tolerance-ms, --detections
@@ -49,6 +51,7 @@ void Smooth(const SmoothOptions& options) {
   PrintSkippedRows("smooth", skipped_rows);
   VisionFrameSource source(dataset, options.frames);
   SlidingWindowEstimator estimator(dataset.calibration, RequireDock(dataset), config.estimator);
+  if (!options.start.empty()) estimator.SetStartState(LoadStartState(options.start));
   EstimateWriter writer(options.out, options.euroc_csv);
 
   const CancellationToken cancel = InstallSignalCancellation();
@@ -81,6 +84,7 @@ void Smooth(const SmoothOptions& options) {
   if (!options.quiet) std::fprintf(stderr, "\n");
 
   BatchSmootherOptions batch;
+  batch.start = estimator.applied_start();
   if (!options.quiet) {
     batch.progress = [](int iteration, double cost) {
       std::fprintf(stderr, "\rsmooth: batch iteration %d, cost %.6g   ", iteration, cost);
@@ -172,6 +176,9 @@ void AddSmoothCommand(CLI::App& root) {
   AddDockOption(sub, &options->dock);
   sub->add_option("--out", options->out, "Output folder (must not exist or be empty)")->required();
   sub->add_option("--config", options->config, "Estimator and go/no-go options (YAML)");
+  sub->add_option("--start", options->start,
+                  "A starting state (YAML: t_ns, p_D, rpy_deg, v_D and their sigmas; an INS's "
+                  "output, a surveyed launch): the window starts from it");
   AddFrameSourceOptions(sub, &options->frames,
                         "Replay these light detections (detections.csv: `simulate` with "
                         "render_images false, `frontend`, or a detector of your own) instead of "

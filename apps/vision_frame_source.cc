@@ -13,6 +13,7 @@
 #include <string>
 
 #include "apps/reason_class.h"
+#include "auvdock/estimator/state_times.h"
 #include "auvdock/estimator/vision_frame_builder.h"
 #include "auvdock/io/input_error.h"
 
@@ -100,16 +101,38 @@ void AddFrameSourceOptions(CLI::App* sub, FrameSourceOptions* options,
                   "the shortest frame interval; 0: equal time stamps only)")
       ->check(NonNegative("milliseconds"));
   sub->add_option("--detections", options->detections, detections_help);
+  sub->add_option("--state-rate-hz", options->state_rate_hz,
+                  "Without cameras (IMU with DVL, depth, fixes, heading): a state this many times "
+                  "a second over the IMU's span (default 10)")
+      ->check(CLI::PositiveNumber);
 }
 
 VisionFrameSource::VisionFrameSource(const Dataset& dataset, const FrameSourceOptions& options)
     : VisionFrameSource(dataset, ParseDetectorKind(options.detector),
-                        SyncToleranceNs(options.sync_tolerance_ms), options.detections) {}
+                        SyncToleranceNs(options.sync_tolerance_ms), options.detections,
+                        options.state_rate_hz) {}
 
 VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind detector,
-                                     int64_t sync_tolerance_ns, const std::string& detections_path)
+                                     int64_t sync_tolerance_ns, const std::string& detections_path,
+                                     double state_rate_hz)
     : pipeline_(dataset.calibration, RequireDock(dataset), PipelineOptions(detector)) {
   cameras_ = {pipeline_.left_camera(), pipeline_.right_camera(), pipeline_.mono_camera()};
+  if (dataset.calibration.cameras.empty() && detections_path.empty()) {
+    if (dataset.imu.size() < 2) {
+      throw InputError(dataset.root + ": no camera and no IMU samples: no state to estimate");
+    }
+    without_cameras_ = true;
+    for (const int64_t t : StateTimesWithoutCameras(dataset.imu.front().t_ns,
+                                                    dataset.imu.back().t_ns, state_rate_hz)) {
+      FrameImages frame;
+      frame.t_ns = t;
+      frames_.push_back(frame);
+    }
+    if (frames_.empty()) {
+      throw InputError(dataset.root + ": the IMU's samples span less than one state interval");
+    }
+    return;
+  }
   if (dataset.calibration.acoustic) {
     fixes_ = dataset.acoustic;
     // In arrival order: the pipeline sees a fix only once it has arrived (causal), and ages it
@@ -196,6 +219,12 @@ std::optional<VisionFrame> VisionFrameSource::Next(const Predictor& predict) {
   if (next_ == frames_.size()) return std::nullopt;
   const FrameImages& group = frames_[next_++];
   const int64_t t = group.t_ns;
+  if (without_cameras_) {
+    VisionFrame state;
+    state.t_ns = t;
+    ++no_vision_reasons_["no camera in the calibration: a state at --state-rate-hz"];
+    return state;
+  }
   std::array<cv::Mat, 3> images;
   if (prefetcher_) {
     DecodedFrame decoded = prefetcher_->Take();

@@ -18,6 +18,10 @@
 // VisionFrame (mono_dt_ns, stereo_dt_ns) and the estimator moves its observations to t0 with the
 // IMU. The stereo pair is triangulated as one exposure: when its two images are more than 1 ms
 // apart, a warning says so. A synchronised rig gives the frames it always did.
+//
+// Without cameras (a calibration without any, a navigator's log of IMU, DVL, depth, fixes,
+// heading): frames without images at state_rate_hz over the IMU's span
+// (estimator/state_times.h), each an empty VisionFrame: the estimator's states.
 #pragma once
 
 #include <array>
@@ -49,6 +53,7 @@ struct FrameSourceOptions {
   std::string detector = "contrast";  // --detector
   double sync_tolerance_ms = -1.0;    // --sync-tolerance-ms; < 0: half the shortest interval
   std::string detections;             // --detections: replay this file instead of the images
+  double state_rate_hz = 10.0;        // --state-rate-hz: states without cameras
 };
 // Registers --detector, --sync-tolerance-ms and --detections (described by detections_help).
 void AddFrameSourceOptions(CLI::App* sub, FrameSourceOptions* options,
@@ -60,10 +65,11 @@ class VisionFrameSource {
   // when given, none), or when detections_path is malformed.
   // sync_tolerance_ns < 0: the default above; 0: only images with equal time stamps share a
   // frame. detections_path: replay that detections.csv instead of the images.
+  // state_rate_hz: the states' rate when the calibration has no camera.
   explicit VisionFrameSource(const Dataset& dataset,
                              LightDetectorKind detector = LightDetectorKind::kContrast,
                              int64_t sync_tolerance_ns = -1,
-                             const std::string& detections_path = "");
+                             const std::string& detections_path = "", double state_rate_hz = 10.0);
   // The same, from the command line's options.
   VisionFrameSource(const Dataset& dataset, const FrameSourceOptions& options);
   VisionFrameSource(const VisionFrameSource&) = delete;  // its decoder refers to it
@@ -119,6 +125,7 @@ class VisionFrameSource {
   int64_t sync_tolerance_ns_ = 0;
   std::vector<FrameImages> frames_;
   bool replaying_ = false;               // detections.csv instead of the images
+  bool without_cameras_ = false;         // no camera in the calibration: states at a rate
   std::vector<ImageDetections> replay_;  // replay: the file's images
   GivenIdentityCounts given_;
   size_t next_ = 0;

@@ -122,19 +122,32 @@ BatchSolve SolveBatch(ceres::Problem* problem,
   return result;
 }
 
-void AddInitialPriors(ceres::Problem* problem, const EstimatorOptions& o, BatchState* s) {
-  Matrix6d pose_cov = Matrix6d::Zero();
-  pose_cov.topLeftCorner<3, 3>().diagonal().setConstant(o.init_position_sigma_m *
-                                                        o.init_position_sigma_m);
-  pose_cov.bottomRightCorner<3, 3>().diagonal().setConstant(o.init_attitude_sigma_rad *
-                                                            o.init_attitude_sigma_rad);
-  problem->AddResidualBlock(PosePriorFactor::Create(PoseFromBlock(s->pose), pose_cov), nullptr,
-                            s->pose);
-  problem->AddResidualBlock(
-      VelocityPriorFactor::Create(Eigen::Vector3d::Zero(),
-                                  Eigen::Matrix3d::Identity() * o.init_velocity_sigma_mps *
-                                      o.init_velocity_sigma_mps),
-      nullptr, s->velocity);
+// The priors of a segment's first state: the given start's pose and velocity with their
+// covariance when the user gave one for this state, else the initial sigmas about the warm start
+// (pose) and zero (velocity); the biases' always.
+void AddInitialPriors(ceres::Problem* problem, const EstimatorOptions& o, BatchState* s,
+                      const InitialState* given_start) {
+  if (given_start != nullptr) {
+    problem->AddResidualBlock(
+        PosePriorFactor::Create(given_start->T_D_B, given_start->pose_covariance), nullptr,
+        s->pose);
+    problem->AddResidualBlock(
+        VelocityPriorFactor::Create(given_start->v_D, given_start->velocity_covariance), nullptr,
+        s->velocity);
+  } else {
+    Matrix6d pose_cov = Matrix6d::Zero();
+    pose_cov.topLeftCorner<3, 3>().diagonal().setConstant(o.init_position_sigma_m *
+                                                          o.init_position_sigma_m);
+    pose_cov.bottomRightCorner<3, 3>().diagonal().setConstant(o.init_attitude_sigma_rad *
+                                                              o.init_attitude_sigma_rad);
+    problem->AddResidualBlock(PosePriorFactor::Create(PoseFromBlock(s->pose), pose_cov), nullptr,
+                              s->pose);
+    problem->AddResidualBlock(
+        VelocityPriorFactor::Create(
+            Eigen::Vector3d::Zero(),
+            Eigen::Matrix3d::Identity() * o.init_velocity_sigma_mps * o.init_velocity_sigma_mps),
+        nullptr, s->velocity);
+  }
   Matrix6d bias_cov = Matrix6d::Zero();
   bias_cov.topLeftCorner<3, 3>().diagonal().setConstant(o.init_gyro_bias_sigma *
                                                         o.init_gyro_bias_sigma);
@@ -299,7 +312,8 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
       }
     }
     if (!joined) {
-      AddInitialPriors(&problem, estimator_options, s);
+      const bool given = options.start && options.start->t_ns == s->t_ns;
+      AddInitialPriors(&problem, estimator_options, s, given ? &*options.start : nullptr);
       ++result.segments;
     }
     const auto f = frame_at.find(s->t_ns);

@@ -1,6 +1,7 @@
 #include "auvdock/estimator/marginalization.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <unordered_set>
 
@@ -14,15 +15,27 @@ int TangentSizeOf(const ceres::Problem& problem, double* block) {
   return problem.ParameterBlockTangentSize(block);
 }
 
-// Moore-Penrose inverse of a symmetric positive semi-definite matrix.
+// The Jacobi scaling of a symmetric positive semi-definite matrix: w_i = 1 / sqrt(A_ii) (0 where
+// A_ii is not positive), so that W A W has a unit diagonal.
+Eigen::VectorXd JacobiScaling(const Eigen::MatrixXd& A) {
+  Eigen::VectorXd w(A.rows());
+  for (Eigen::Index i = 0; i < A.rows(); ++i) w[i] = A(i, i) > 0.0 ? 1.0 / std::sqrt(A(i, i)) : 0.0;
+  return w;
+}
+
+// Moore-Penrose inverse of a symmetric positive semi-definite matrix, its rank decided on the
+// Jacobi-scaled matrix (JacobiScaling): A^+ = W (W A W)^+ W.
 Eigen::MatrixXd PseudoInverse(const Eigen::MatrixXd& A, double relative_floor) {
   if (A.rows() == 0) return A;
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(A);
+  const Eigen::VectorXd w = JacobiScaling(A);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(w.asDiagonal() * A * w.asDiagonal());
   const Eigen::VectorXd& s = eig.eigenvalues();
   const double floor = relative_floor * std::max(0.0, s.maxCoeff());
   Eigen::VectorXd s_inv(s.size());
   for (int i = 0; i < s.size(); ++i) s_inv[i] = s[i] > floor && s[i] > 0.0 ? 1.0 / s[i] : 0.0;
-  return eig.eigenvectors() * s_inv.asDiagonal() * eig.eigenvectors().transpose();
+  return w.asDiagonal() *
+         (eig.eigenvectors() * s_inv.asDiagonal() * eig.eigenvectors().transpose()) *
+         w.asDiagonal();
 }
 
 }  // namespace
@@ -103,7 +116,15 @@ LinearizedPrior MarginalizeOut(ceres::Problem* problem, const std::vector<double
     H_star = 0.5 * (H_star + H_star.transpose()).eval();
     const Eigen::VectorXd b_star = b.tail(k) - H_km * H_mm_inv * b.head(m);
 
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(H_star);
+    // The rank is decided on the Jacobi-scaled H* (unit diagonal), not on H* itself: its
+    // coordinates are in different units, and a navigation-grade IMU's bias walk gives the
+    // biases 1e11-1e15 of information where a prior gives the position 1-100; unscaled, the
+    // position's directions fell under the floor and were dropped as unobserved (A-KIT without
+    // fixes: the position left free, hundreds of metres off within a minute).
+    // With H_s = W H* W = V S V^T: J* = S^1/2 V^T W^-1, r0 = S^-1/2 V^T W b*.
+    const Eigen::VectorXd w = JacobiScaling(H_star);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(w.asDiagonal() * H_star *
+                                                             w.asDiagonal());
     const Eigen::VectorXd& s = eig.eigenvalues();
     const double floor = options.relative_eigen_floor * std::max(0.0, s.maxCoeff());
     std::vector<int> kept_directions;
@@ -113,11 +134,14 @@ LinearizedPrior MarginalizeOut(ceres::Problem* problem, const std::vector<double
     const int rank = static_cast<int>(kept_directions.size());
     prior.sqrt_information.resize(rank, k);
     prior.residual.resize(rank);
+    const Eigen::VectorXd w_inv = w.unaryExpr([](double x) { return x > 0.0 ? 1.0 / x : 0.0; });
+    const Eigen::VectorXd scaled_b = w.asDiagonal() * b_star;
     for (int i = 0; i < rank; ++i) {
       const int d = kept_directions[i];
       const double sqrt_s = std::sqrt(s[d]);
-      prior.sqrt_information.row(i) = sqrt_s * eig.eigenvectors().col(d).transpose();
-      prior.residual[i] = eig.eigenvectors().col(d).dot(b_star) / sqrt_s;
+      prior.sqrt_information.row(i) =
+          sqrt_s * (eig.eigenvectors().col(d).transpose() * w_inv.asDiagonal());
+      prior.residual[i] = eig.eigenvectors().col(d).dot(scaled_b) / sqrt_s;
     }
   } else {
     prior.blocks.clear();

@@ -229,6 +229,39 @@ bool SlidingWindowEstimator::Initialize(const VisionFrame& frame) {
   return true;
 }
 
+bool SlidingWindowEstimator::InitializeFromGivenStart(int64_t t_ns) {
+  if (!given_start_ || t_ns < given_start_->t_ns) return false;
+  InitialState start = *given_start_;
+  const int64_t given_t_ns = start.t_ns;
+  if (given_t_ns != 0 && given_t_ns != t_ns) {
+    // Carried by the IMU from its time to the frame's (zero bias: the bias priors hold it).
+    const std::optional<ImuPreintegration> pim = imu_.Preintegrate(given_t_ns, t_ns, ImuBias());
+    if (!pim) {
+      init_refusal_ = "the given start's time is not covered by the IMU up to the first state";
+      return false;
+    }
+    NavState nav;
+    nav.q_D_B = start.T_D_B.q;
+    nav.p_D = start.T_D_B.p;
+    nav.v_D = start.v_D;
+    const NavState at_frame = pim->Predict(nav, ImuBias(), dock_.gravity_D, EarthRate_D(dock_));
+    start.T_D_B = Pose3(at_frame.q_D_B, at_frame.p_D);
+    start.v_D = at_frame.v_D;
+  }
+  start.t_ns = t_ns;
+  init_refusal_.clear();
+  given_start_.reset();
+  applied_start_ = start;
+  stats_.log.push_back("start from the given state at " + std::to_string(t_ns) + " ns");
+  StartWindow(start);
+  // The user vouches for the state (an INS's output, a survey): the DVL is tested against it by
+  // the gate from the first sample, as after the acoustic start's fit, not held out until the
+  // window's own velocity could see a gross bias (with a navigator's velocity sigma of a few
+  // cm/s that never comes without the DVL itself, and the IMU alone then drifts away).
+  dvl_admitted_ = true;
+  return true;
+}
+
 bool SlidingWindowEstimator::InitializeAcoustically(int64_t t_ns) {
   if (!options_.acoustic_init.enabled || !acoustic_init_.has_new_data()) return false;
   std::string why;
@@ -839,7 +872,10 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   last_frame_t_ns_ = frame.t_ns;
 
   if (window_.empty()) {
-    if (!Initialize(frame) && !InitializeAcoustically(frame.t_ns)) return std::nullopt;
+    if (!InitializeFromGivenStart(frame.t_ns) && !Initialize(frame) &&
+        !InitializeAcoustically(frame.t_ns)) {
+      return std::nullopt;
+    }
   } else if (!AddState(frame.t_ns)) {
     // One reset per outage: while no IMU sample has come since the last reset for a gap, the
     // window restarts at each frame of the outage without counting it again.
@@ -849,7 +885,10 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
                             std::to_string(options_.max_imu_gap_s) + " s) up to " +
                             std::to_string(frame.t_ns) + " ns");
     imu_outage_newest_t_ns_ = imu_.newest_t_ns();
-    if (!Initialize(frame) && !InitializeAcoustically(frame.t_ns)) return std::nullopt;
+    if (!InitializeFromGivenStart(frame.t_ns) && !Initialize(frame) &&
+        !InitializeAcoustically(frame.t_ns)) {
+      return std::nullopt;
+    }
   }
   State* state = window_.back().get();
   VisionFactorOptions vision = options_.vision;

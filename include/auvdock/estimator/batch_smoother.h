@@ -48,6 +48,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "auvdock/estimator/sliding_window_estimator.h"
@@ -66,6 +67,10 @@ struct BatchSmootherOptions {
   bool information_at_warm_start = false;
   // Called after every solver iteration with (iteration, cost); may be empty.
   std::function<void(int, double)> progress;
+  // A starting state the user gave (estimator/start_state.h), as the window's first state took
+  // it (SlidingWindowEstimator::applied_start): the priors of the state at its time, instead of
+  // the initial priors about the warm start.
+  std::optional<InitialState> start;
 };
 
 struct BatchResult {

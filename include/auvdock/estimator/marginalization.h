@@ -7,9 +7,10 @@
 //   J = [J_m  J_k],  r,   H = J^T J,  b = J^T r,
 // over the marginalized blocks m and the kept blocks k they connect to. Eliminating m,
 //   H* = H_kk - H_km H_mm^+ H_mk,     b* = b_k - H_km H_mm^+ b_m,
-// and with the eigen-decomposition H* = V S V^T (eigenvalues below relative_eigen_floor times
-// the largest dropped, so an unobservable direction carries no information rather than noise):
-//   J* = S^1/2 V^T,   r0 = S^-1/2 V^T b*,
+// and with the Jacobi scaling W = diag(H*)^-1/2 (its coordinates are in different units) and the
+// eigen-decomposition W H* W = V S V^T (eigenvalues below relative_eigen_floor times the largest
+// dropped, so an unobservable direction carries no information rather than noise):
+//   J* = S^1/2 V^T W^-1,   r0 = S^-1/2 V^T W b*,
 // which is the MarginalizationFactor's prior (J*^T J* = H*, J*^T r0 = b*). The residual blocks
 // and the marginalized parameter blocks are then removed from the problem; the caller adds the
 // returned prior back as a MarginalizationFactor.

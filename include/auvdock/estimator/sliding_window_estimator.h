@@ -417,6 +417,14 @@ class SlidingWindowEstimator {
   // An SBL range, the same way (by its ping's time).
   void AddSblRange(const SblRange& range);
 
+  // A starting state the user gives (estimator/start_state.h): the window starts from it at the
+  // first frame at or after start.t_ns (any frame when 0), carried to the frame's time by the
+  // IMU, before a per-frame pose or the acoustic start could. Used once: a reset later restarts
+  // as without it. Call before the frames.
+  void SetStartState(const InitialState& start) { given_start_ = start; }
+  // The given start as the window's first state took it (at that state's time), once applied.
+  const std::optional<InitialState>& applied_start() const { return applied_start_; }
+
   // A camera frame (identified lights; possibly none). Returns the newest state's estimate, or
   // nothing before initialisation / after a reset until the next per-frame pose.
   std::optional<EstimatorOutput> AddVisionFrame(const VisionFrame& frame);
@@ -442,6 +450,8 @@ class SlidingWindowEstimator {
   struct State;
 
   bool Initialize(const VisionFrame& frame);
+  // The given start (SetStartState) at t_ns, when it is due and the IMU carries it there.
+  bool InitializeFromGivenStart(int64_t t_ns);
   // The acoustic start at t_ns, tried when a fix came since the last try.
   bool InitializeAcoustically(int64_t t_ns);
   // The window's first state with its priors (the biases' from EstimatorOptions).
@@ -549,6 +559,8 @@ class SlidingWindowEstimator {
   // estimate_dvl_bias with a DVL in use: every state has its DVL-bias block.
   bool dvl_bias_on_ = false;
   std::string init_refusal_;
+  std::optional<InitialState> given_start_;    // SetStartState, until applied
+  std::optional<InitialState> applied_start_;  // as the first state took it
   EstimatorStats stats_;
   // Per light id: the adaptive variance factors of its mono pixels and its stereo points.
   std::map<int, AdaptiveNoiseScale> mono_noise_;

@@ -1,0 +1,117 @@
+// End-to-end: a navigator's log without cameras (IMU, depth, DVL, acoustic fixes; the simulator's
+// dataset with its cameras taken out of the calibration). `run` and `smooth` make their own
+// states at --state-rate-hz over the IMU's span, start from the fixes and the DVL's path, and
+// estimate every state after the start; the summary says why no state had vision.
+#include <cmath>
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/testing/run_command.h"
+#include "tests/testing/temp_dir.h"
+#include "tests/testing/test_scenarios.h"
+
+using ::testing::HasSubstr;
+
+namespace auvdock {
+namespace {
+
+TEST(WithoutCamerasCli, RunAndSmoothMakeTheirOwnStates) {
+  test::TempDir tmp;
+  const std::string scenario = tmp / "nav.yaml";
+  test::WriteTextFile(scenario, "name: nav\nduration_s: 30.0\ndock: " +
+                                    test::SourcePath("data/docks/t_shape.yaml") + "\n");
+  const std::string dataset = tmp / "nav";
+  ASSERT_EQ(test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset,
+                              "--detections-only", "--quiet"})
+                .exit_status,
+            0);
+  YAML::Node calibration = YAML::LoadFile(dataset + "/calibration.yaml");
+  calibration.remove("cameras");
+  YAML::Emitter out;
+  out << calibration;
+  test::WriteTextFile(dataset + "/calibration.yaml", out.c_str());
+
+  for (const std::string command : {"run", "smooth"}) {
+    const std::string result = tmp / (command + "_out");
+    const auto r = test::RunAuvdock(
+        {command, "--dataset", dataset, "--out", result, "--quiet", "--state-rate-hz", "5"});
+    ASSERT_EQ(r.exit_status, 0) << command << ": " << r.err;
+    EXPECT_THAT(r.out, HasSubstr("no camera in the calibration")) << command;
+    const nlohmann::json summary =
+        nlohmann::json::parse(test::ReadTextFile(result + "/summary.json"));
+    // 30 s of IMU at 5 states a second, the first one period after the first sample.
+    EXPECT_NEAR(summary["frames"].get<int>(), 150, 1) << command;
+    EXPECT_GT(summary["estimates"].get<int>(), 100) << command;  // after the acoustic start
+    EXPECT_EQ(summary["acoustic_starts"].get<int>(), 1) << command;
+  }
+  const auto bad = test::RunAuvdock(
+      {"run", "--dataset", dataset, "--out", tmp / "bad", "--quiet", "--state-rate-hz", "0"});
+  EXPECT_EQ(bad.exit_status, 2);
+}
+
+// A navigator's log without cameras and without fixes (IMU, depth, DVL): nothing starts the
+// window, every state says why; with --start (the true state at the first state's time, as an
+// INS would give it) every state is estimated from it, the first one at the given pose. A start
+// file with a bad key names the file and the key, exit 2.
+TEST(WithoutCamerasCli, AGivenStartStartsTheWindow) {
+  test::TempDir tmp;
+  const std::string scenario = tmp / "nav.yaml";
+  test::WriteTextFile(scenario, "name: nav\nduration_s: 20.0\ndock: " +
+                                    test::SourcePath("data/docks/t_shape.yaml") + "\n");
+  const std::string dataset = tmp / "nav";
+  ASSERT_EQ(test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset,
+                              "--detections-only", "--quiet"})
+                .exit_status,
+            0);
+  YAML::Node calibration = YAML::LoadFile(dataset + "/calibration.yaml");
+  calibration.remove("cameras");
+  calibration.remove("acoustic");
+  YAML::Emitter out;
+  out << calibration;
+  test::WriteTextFile(dataset + "/calibration.yaml", out.c_str());
+
+  const auto without =
+      test::RunAuvdock({"run", "--dataset", dataset, "--out", tmp / "without", "--quiet"});
+  ASSERT_EQ(without.exit_status, 0) << without.err;
+  EXPECT_THAT(without.out, HasSubstr(": 0 estimates"));
+  EXPECT_THAT(test::ReadTextFile(tmp / "without/decisions.csv"), HasSubstr("not initialised"));
+
+  // The simulator's first true state (t = its first IMU sample): roll, pitch, yaw of
+  // q = (0.99660, -0.00092, 0.01121, 0.08162) and its velocity.
+  const std::string start = tmp / "start.yaml";
+  test::WriteTextFile(start,
+                      "t_ns: 1700000000000000000\np_D: [-8.0, 1.0738800516653348, "
+                      "-4.428703411195086]\nrpy_deg: [0.0, 1.2884, 9.3639]\n"
+                      "v_D: [0.49613893835683387, 0.026255517880197796, 0.038000379807131134]\n"
+                      "position_sigma_m: 0.1\ntilt_sigma_deg: 0.5\nheading_sigma_deg: 1.0\n"
+                      "velocity_sigma_mps: 0.05\n");
+  const auto with = test::RunAuvdock(
+      {"run", "--dataset", dataset, "--out", tmp / "with", "--quiet", "--start", start});
+  ASSERT_EQ(with.exit_status, 0) << with.err;
+  EXPECT_THAT(with.err, HasSubstr("start from the given state"));
+  const nlohmann::json summary =
+      nlohmann::json::parse(test::ReadTextFile(tmp / "with/summary.json"));
+  EXPECT_EQ(summary["estimates"].get<int>(), summary["frames"].get<int>());
+  const auto e = test::RunAuvdock(
+      {"evaluate", "--dataset", dataset, "--estimate", tmp / "with/trajectory.tum", "--json"});
+  ASSERT_EQ(e.exit_status, 0) << e.err;
+  // Dead reckoning on the DVL for 20 s from a start known to 0.1 m.
+  EXPECT_LT(nlohmann::json::parse(e.out).at("pos_rmse_m").get<double>(), 0.3) << e.out;
+
+  test::WriteTextFile(start,
+                      "p_D: [0, 0, 0]\nrpy_deg: [0, 0, 0]\nposition_sigma_m: 0.1\n"
+                      "tilt_sigma_deg: 0.5\nheading_sigma_deg: -1\n"
+                      "velocity_sigma_mps: 0.05\n");
+  const auto bad = test::RunAuvdock(
+      {"run", "--dataset", dataset, "--out", tmp / "bad", "--quiet", "--start", start});
+  EXPECT_EQ(bad.exit_status, 2);
+  EXPECT_THAT(bad.err, HasSubstr("start.yaml"));
+  EXPECT_THAT(bad.err, HasSubstr("heading_sigma_deg"));
+}
+
+}  // namespace
+}  // namespace auvdock
