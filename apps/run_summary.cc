@@ -74,6 +74,7 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                                          {"depth", stats.depth_variance_factor},
                                          {"sbl", stats.sbl_variance_factor}};
   summary["resets"] = stats.resets;
+  summary["divergences"] = stats.divergences;  // resets for fixes the gate refused (divergence)
   summary["init_refused"] = stats.init_refused;
   summary["solver_failures"] = stats.solver_failures;
   summary["covariance_failures"] = stats.covariance_failures;

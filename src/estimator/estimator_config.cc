@@ -42,6 +42,10 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.usbl_rate_test.enabled = est.GetBool("usbl_rate_test", e.usbl_rate_test.enabled);
   e.usbl_rate_test.max_speed_mps =
       est.GetPositive("usbl_rate_max_speed_mps", e.usbl_rate_test.max_speed_mps);
+  e.divergence_fixes = est.GetInt("divergence_fixes", e.divergence_fixes);
+  if (e.divergence_fixes < 0) est.Fail("divergence_fixes", "must not be negative");
+  e.divergence_gated_share = est.GetPositive("divergence_gated_share", e.divergence_gated_share);
+  if (e.divergence_gated_share > 1.0) est.Fail("divergence_gated_share", "must be at most 1");
   e.usbl_rate_test.speed_margin_mps =
       est.GetNonNegative("usbl_rate_speed_margin_mps", e.usbl_rate_test.speed_margin_mps);
   e.usbl_max_backward_shift_s =

@@ -146,6 +146,7 @@ void SlidingWindowEstimator::Reset(const std::string& reason) {
   }
   dvl_rate_test_.Reset();
   dvl_admitted_ = false;
+  recent_fix_gated_.clear();
   newest_pose_velocity_covariance_.reset();
   newest_depth_offset_variance_.reset();
   sbl_transducer_of_.clear();
@@ -178,11 +179,15 @@ void SlidingWindowEstimator::AddImu(const ImuSample& sample) {
       window_.empty() ? 0
                       : window_.front()->t_ns -
                             static_cast<int64_t>(options_.usbl_max_backward_shift_s * kNsPerSecond);
-  // Before initialisation the acoustic start traces the path over its span.
+  // The acoustic start traces the path over its span: before initialisation, and after a reset
+  // (a divergence restarts from the fixes), so its span is kept all along (a binary search
+  // finds an interval's first sample: a longer buffer costs no time).
   const double history_s = options_.acoustic_init.enabled ? acoustic_init_.imu_history_s() : 1.0;
+  const int64_t history_ns = sample.t_ns - static_cast<int64_t>(history_s * kNsPerSecond);
   imu_.DropBefore(window_.empty()
-                      ? sample.t_ns - static_cast<int64_t>(history_s * kNsPerSecond)
-                      : std::min({window_.front()->t_ns, rate_test_ns, late_fix_ns}));
+                      ? history_ns
+                      : std::min({window_.front()->t_ns, rate_test_ns, late_fix_ns,
+                                  options_.acoustic_init.enabled ? history_ns : INT64_MAX}));
 }
 
 std::string SlidingWindowEstimator::TiltRefusal(const VisionFrame& frame) const {
@@ -957,6 +962,9 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
     Reset("solver failed at " + std::to_string(frame.t_ns) + " ns (after gating)");
     return std::nullopt;
   }
+  if (ResetOnDivergence(static_cast<int>(usbl.size()), usbl_gated, frame.t_ns)) {
+    return std::nullopt;
+  }
   stats_.gated_observations += state->n_gated;
   stats_.used_observations += static_cast<int>(state->vision.size());
   if (!state->vision.empty()) last_vision_t_ns_ = frame.t_ns;
@@ -975,6 +983,35 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   }
   ++stats_.frames_with_output;
   return out;
+}
+
+bool SlidingWindowEstimator::ResetOnDivergence(int kept_fixes, int gated_fixes, int64_t t_ns) {
+  if (options_.divergence_fixes <= 0 || kept_fixes + gated_fixes == 0) return false;
+  for (int k = 0; k < gated_fixes; ++k) recent_fix_gated_.emplace_back(t_ns, true);
+  for (int k = 0; k < kept_fixes; ++k) recent_fix_gated_.emplace_back(t_ns, false);
+  while (static_cast<int>(recent_fix_gated_.size()) > options_.divergence_fixes) {
+    recent_fix_gated_.pop_front();
+  }
+  if (static_cast<int>(recent_fix_gated_.size()) < options_.divergence_fixes) return false;
+  const int refused = static_cast<int>(
+      std::count_if(recent_fix_gated_.begin(), recent_fix_gated_.end(),
+                    [](const std::pair<int64_t, bool>& verdict) { return verdict.second; }));
+  if (refused < options_.divergence_gated_share * options_.divergence_fixes) return false;
+  // A light used over the span of these fixes: the lights are believed, not the fixes.
+  if (last_vision_t_ns_ != INT64_MIN && last_vision_t_ns_ >= recent_fix_gated_.front().first) {
+    return false;
+  }
+  ++stats_.divergences;
+  char text[220];
+  std::snprintf(text, sizeof(text),
+                "divergence: the gate refused %d of the last %d acoustic fixes, which agree with "
+                "each other (rate test), and no light was in use: the state is wrong; restarting "
+                "from the fixes at %lld ns",
+                refused, options_.divergence_fixes, static_cast<long long>(t_ns));
+  recent_fix_gated_.clear();
+  Reset(text);
+  init_refusal_ = text;  // this frame's reason for no estimate, until the restart
+  return true;
 }
 
 void SlidingWindowEstimator::UpdateNoiseScales(const State& state, const Matrix6d& covariance) {

@@ -2,7 +2,9 @@
 // dataset with its cameras taken out of the calibration). `run` and `smooth` make their own
 // states at --state-rate-hz over the IMU's span, start from the fixes and the DVL's path, and
 // estimate every state after the start; the summary says why no state had vision.
+#include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -111,6 +113,67 @@ TEST(WithoutCamerasCli, AGivenStartStartsTheWindow) {
   EXPECT_EQ(bad.exit_status, 2);
   EXPECT_THAT(bad.err, HasSubstr("start.yaml"));
   EXPECT_THAT(bad.err, HasSubstr("heading_sigma_deg"));
+}
+
+// Divergence: a start given 20 m off with a sigma of 0.1 m makes the gate refuse every fix,
+// which agree with each other; with no light in view the window is reset ("divergence", the
+// frame's NO-GO says why) and starts again from the fixes, and ends where the truth does.
+TEST(WithoutCamerasCli, AWindowThatRefusesEveryFixRestartsFromThem) {
+  test::TempDir tmp;
+  const std::string scenario = tmp / "nav.yaml";
+  test::WriteTextFile(scenario, "name: nav\nduration_s: 30.0\ndock: " +
+                                    test::SourcePath("data/docks/t_shape.yaml") + "\n");
+  const std::string dataset = tmp / "nav";
+  ASSERT_EQ(test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset,
+                              "--detections-only", "--quiet"})
+                .exit_status,
+            0);
+  YAML::Node calibration = YAML::LoadFile(dataset + "/calibration.yaml");
+  calibration.remove("cameras");
+  YAML::Emitter out;
+  out << calibration;
+  test::WriteTextFile(dataset + "/calibration.yaml", out.c_str());
+  const std::string start = tmp / "start.yaml";
+  test::WriteTextFile(start,
+                      "t_ns: 1700000000000000000\np_D: [12.0, 1.07, -4.43]\n"
+                      "rpy_deg: [0.0, 1.2884, 9.3639]\nv_D: [0.496, 0.026, 0.038]\n"
+                      "position_sigma_m: 0.1\ntilt_sigma_deg: 0.5\nheading_sigma_deg: 1.0\n"
+                      "velocity_sigma_mps: 0.05\n");
+  const auto r = test::RunAuvdock(
+      {"run", "--dataset", dataset, "--out", tmp / "out", "--quiet", "--start", start});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("divergence: the gate refused"));
+  const nlohmann::json summary =
+      nlohmann::json::parse(test::ReadTextFile(tmp / "out/summary.json"));
+  EXPECT_EQ(summary["divergences"].get<int>(), 1);
+  EXPECT_EQ(summary["acoustic_starts"].get<int>(), 1);
+  EXPECT_THAT(test::ReadTextFile(tmp / "out/decisions.csv"),
+              HasSubstr("not initialised (divergence"));
+  // The last estimate against the truth at its time.
+  std::istringstream tum(test::ReadTextFile(tmp / "out/trajectory.tum"));
+  std::string line, last;
+  while (std::getline(tum, line)) {
+    if (!line.empty() && line[0] != '#') last = line;
+  }
+  std::istringstream fields(last);
+  double t_s = 0.0, x = 0.0, y = 0.0;
+  fields >> t_s >> x >> y;
+  std::istringstream truth(test::ReadTextFile(dataset + "/groundtruth/data.csv"));
+  double best_dt = 1e9, truth_x = 0.0, truth_y = 0.0;
+  while (std::getline(truth, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream row(line);
+    double t_ns = 0.0, tx = 0.0, ty = 0.0;
+    row >> t_ns >> tx >> ty;
+    if (std::abs(t_ns * 1e-9 - t_s) < best_dt) {
+      best_dt = std::abs(t_ns * 1e-9 - t_s);
+      truth_x = tx;
+      truth_y = ty;
+    }
+  }
+  EXPECT_LT(best_dt, 0.01);
+  EXPECT_LT(std::hypot(x - truth_x, y - truth_y), 0.3) << last;
 }
 
 }  // namespace

@@ -48,12 +48,13 @@
 #pragma once
 
 #include <cstdint>
-#include <limits>
 #include <deque>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -242,6 +243,16 @@ struct EstimatorOptions {
   // before initialisation and arriving after it caused 5 of the 7 Monte-Carlo runs with unsafe
   // GO, README).
   double usbl_max_backward_shift_s = 1.0;
+  // Divergence: when the gate refuses at least divergence_gated_share of the last
+  // divergence_fixes acoustic fixes (each of which passed the rate test, so the fixes agree with
+  // each other), and no light was used over the same span, it is the state that is wrong, not
+  // the fixes: the window is reset (logged, counted in EstimatorStats::divergences) and starts
+  // again from the fixes and the DVL's path (the acoustic start), NO-GO meanwhile (no estimate).
+  // With lights in use, the lights are believed and the fixes stay refused (a beacon that is not
+  // where the dock file says). Without it, a window that started from a wrong heading or a wrong
+  // given start refused every later fix ("0 of 394 fixes used"). 0 fixes: off.
+  int divergence_fixes = 10;
+  double divergence_gated_share = 0.8;
   // Short-baseline ranges (the same, needs the calibration's sbl array and the dock's beacon):
   // each range on its own, 1 dof, p = 0.999, with its own sigma.
   bool use_sbl = true;
@@ -361,6 +372,7 @@ struct EstimatorStats {
   int dvl_skipped = 0;    // out of order, held, before the first state or beyond the IMU
   int dvl_rate_rejected = 0;  // failed the rate-of-change test
   int dvl_not_admitted = 0;  // before admission: untestable yet, or disagreeing (dvl_admission)
+  int divergences = 0;    // resets because the gate refused the agreeing fixes (divergence_fixes)
   int usbl_used = 0;      // acoustic fixes in the cost (after gating)
   int usbl_gated = 0;     // beyond the USBL gate
   int usbl_skipped = 0;   // not finite, out of order, no state or IMU
@@ -456,6 +468,9 @@ class SlidingWindowEstimator {
   bool Initialize(const VisionFrame& frame);
   // The given start (SetStartState) at t_ns, when it is due and the IMU carries it there.
   bool InitializeFromGivenStart(int64_t t_ns);
+  // The divergence test (EstimatorOptions::divergence_fixes) after a frame's gating: true when
+  // the window was reset for it.
+  bool ResetOnDivergence(int kept_fixes, int gated_fixes, int64_t t_ns);
   // The acoustic start at t_ns, tried when a fix came since the last try.
   bool InitializeAcoustically(int64_t t_ns);
   // The window's first state with its priors (the biases' from EstimatorOptions).
@@ -564,6 +579,9 @@ class SlidingWindowEstimator {
   bool dvl_bias_on_ = false;
   std::string init_refusal_;
   std::optional<InitialState> given_start_;    // SetStartState, until applied
+  // The gate's verdicts on the latest fixes (true: refused), with the time of the frame that
+  // gated each (EstimatorOptions::divergence_fixes).
+  std::deque<std::pair<int64_t, bool>> recent_fix_gated_;
   std::optional<InitialState> applied_start_;  // as the first state took it
   EstimatorStats stats_;
   // Per light id: the adaptive variance factors of its mono pixels and its stereo points.
