@@ -21,21 +21,32 @@ using ::testing::HasSubstr;
 namespace auvdock {
 namespace {
 
-TEST(WithoutCamerasCli, RunAndSmoothMakeTheirOwnStates) {
-  test::TempDir tmp;
+// A navigator's log: the simulator's dataset (duration_s of the default approach, from
+// detections) with its cameras, and without with_fixes its acoustic sensor, taken out of the
+// calibration. Returns the dataset folder.
+std::string NavigatorsLog(const test::TempDir& tmp, double duration_s, bool with_fixes) {
   const std::string scenario = tmp / "nav.yaml";
-  test::WriteTextFile(scenario, "name: nav\nduration_s: 30.0\ndock: " +
-                                    test::SourcePath("data/docks/t_shape.yaml") + "\n");
+  test::WriteTextFile(scenario, "name: nav\nduration_s: " + std::to_string(duration_s) +
+                                    "\ndock: " + test::SourcePath("data/docks/t_shape.yaml") +
+                                    "\n");
   const std::string dataset = tmp / "nav";
-  ASSERT_EQ(test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset,
+  EXPECT_EQ(test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset,
                               "--detections-only", "--quiet"})
                 .exit_status,
             0);
   YAML::Node calibration = YAML::LoadFile(dataset + "/calibration.yaml");
   calibration.remove("cameras");
+  if (!with_fixes) calibration.remove("acoustic");
   YAML::Emitter out;
   out << calibration;
   test::WriteTextFile(dataset + "/calibration.yaml", out.c_str());
+  return dataset;
+}
+
+TEST(WithoutCamerasCli, RunAndSmoothMakeTheirOwnStates) {
+  test::TempDir tmp;
+  const std::string dataset = NavigatorsLog(tmp, 30.0, /*with_fixes=*/true);
+  ASSERT_FALSE(::testing::Test::HasFailure());
 
   for (const std::string command : {"run", "smooth"}) {
     const std::string result = tmp / (command + "_out");
@@ -61,20 +72,8 @@ TEST(WithoutCamerasCli, RunAndSmoothMakeTheirOwnStates) {
 // file with a bad key names the file and the key, exit 2.
 TEST(WithoutCamerasCli, AGivenStartStartsTheWindow) {
   test::TempDir tmp;
-  const std::string scenario = tmp / "nav.yaml";
-  test::WriteTextFile(scenario, "name: nav\nduration_s: 20.0\ndock: " +
-                                    test::SourcePath("data/docks/t_shape.yaml") + "\n");
-  const std::string dataset = tmp / "nav";
-  ASSERT_EQ(test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset,
-                              "--detections-only", "--quiet"})
-                .exit_status,
-            0);
-  YAML::Node calibration = YAML::LoadFile(dataset + "/calibration.yaml");
-  calibration.remove("cameras");
-  calibration.remove("acoustic");
-  YAML::Emitter out;
-  out << calibration;
-  test::WriteTextFile(dataset + "/calibration.yaml", out.c_str());
+  const std::string dataset = NavigatorsLog(tmp, 20.0, /*with_fixes=*/false);
+  ASSERT_FALSE(::testing::Test::HasFailure());
 
   const auto without =
       test::RunAuvdock({"run", "--dataset", dataset, "--out", tmp / "without", "--quiet"});
@@ -120,19 +119,8 @@ TEST(WithoutCamerasCli, AGivenStartStartsTheWindow) {
 // frame's NO-GO says why) and starts again from the fixes, and ends where the truth does.
 TEST(WithoutCamerasCli, AWindowThatRefusesEveryFixRestartsFromThem) {
   test::TempDir tmp;
-  const std::string scenario = tmp / "nav.yaml";
-  test::WriteTextFile(scenario, "name: nav\nduration_s: 30.0\ndock: " +
-                                    test::SourcePath("data/docks/t_shape.yaml") + "\n");
-  const std::string dataset = tmp / "nav";
-  ASSERT_EQ(test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset,
-                              "--detections-only", "--quiet"})
-                .exit_status,
-            0);
-  YAML::Node calibration = YAML::LoadFile(dataset + "/calibration.yaml");
-  calibration.remove("cameras");
-  YAML::Emitter out;
-  out << calibration;
-  test::WriteTextFile(dataset + "/calibration.yaml", out.c_str());
+  const std::string dataset = NavigatorsLog(tmp, 30.0, /*with_fixes=*/true);
+  ASSERT_FALSE(::testing::Test::HasFailure());
   const std::string start = tmp / "start.yaml";
   test::WriteTextFile(start,
                       "t_ns: 1700000000000000000\np_D: [12.0, 1.07, -4.43]\n"
