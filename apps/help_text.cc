@@ -56,7 +56,9 @@ std::string SimulateHelp() {
 std::string RunHelp() {
   return "\nNeeds: a dataset folder (from simulate, your log in that layout, or a EuRoC sequence)\n"
          "whose calibration has an IMU; its images, or --detections; a dock (the folder's\n"
-         "dock.yaml, or --dock). Each output uses only data up to its own time.\n"
+         "dock.yaml, or --dock). Each output uses only data up to its own time. A log without\n"
+         "cameras (IMU with DVL, depth, fixes, heading) gets a state at --state-rate-hz; the\n"
+         "window starts from the lights, the fixes, or a state of yours (--start FILE).\n"
          "Writes into --out, flushed frame by frame (an interrupted run keeps what it wrote):\n" +
          std::string(kEstimateFiles) + Shipped("Estimator options (--config)", "estimator") +
          "Example: auvdock run --dataset out/sim --out out/run\n";
