@@ -68,6 +68,9 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
   if (const std::string depth = DepthDisagreementWarning(stats); !depth.empty()) {
     summary["warnings"].push_back(depth);
   }
+  if (const std::string dvl = DvlDisagreementWarning(stats); !dvl.empty()) {
+    summary["warnings"].push_back(dvl);
+  }
   summary["adaptive_variance_factor"] = {{"mono", stats.mono_variance_factor},
                                          {"stereo", stats.stereo_variance_factor},
                                          {"dvl", stats.dvl_variance_factor},
@@ -118,9 +121,23 @@ std::string DepthDisagreementWarning(const EstimatorStats& stats) {
          "true";
 }
 
+std::string DvlDisagreementWarning(const EstimatorStats& stats) {
+  const int refused = stats.dvl_gated + stats.dvl_rate_rejected + stats.dvl_not_admitted;
+  const int samples = stats.dvl_used + refused;
+  if (samples < 20 || 2 * refused <= samples) return {};
+  return "the DVL's rate test, admission and gate refused " + std::to_string(refused) + " of " +
+         std::to_string(samples) +
+         " DVL samples: its velocity disagrees with the IMU's and the other sensors; check the "
+         "DVL's frame (calibration T_B_S) and its time stamps";
+}
+
 void PrintDepthDisagreement(const char* command, const EstimatorStats& stats) {
-  const std::string warning = DepthDisagreementWarning(stats);
-  if (!warning.empty()) std::fprintf(stderr, "auvdock: %s: warning: %s\n", command, warning.c_str());
+  for (const std::string& warning :
+       {DepthDisagreementWarning(stats), DvlDisagreementWarning(stats)}) {
+    if (!warning.empty()) {
+      std::fprintf(stderr, "auvdock: %s: warning: %s\n", command, warning.c_str());
+    }
+  }
 }
 
 void PrintSymmetryUnresolved(const char* command, int count) {

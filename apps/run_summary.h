@@ -44,6 +44,14 @@ void PrintGivenIdentities(const VisionFrameSource& source);
 // of 0.3 m, 80-85 % of the samples are gated; without one, at most 1 %). The warning's text, or
 // empty. MakeRunSummary puts it in "warnings"; PrintDepthDisagreement on stderr.
 std::string DepthDisagreementWarning(const EstimatorStats& stats);
+// The same for the DVL: its rate test, admission and gate refused more than half of at least 20
+// samples (a DVL in another frame than its T_B_S says, rotated 180 deg about z say, or on
+// another clock; with a heading sensor or lights the window sees that its velocity is not the
+// vehicle's). Without a heading sensor and lights, a DVL turned 180 deg about z is the vehicle
+// heading the other way to the acoustic start: nothing refuses it, the position holds and the
+// heading is 180 deg off (simulated: 0.09 m, 3.09 rad); no warning can tell.
+std::string DvlDisagreementWarning(const EstimatorStats& stats);
+// Both warnings on stderr, when there are any.
 void PrintDepthDisagreement(const char* command, const EstimatorStats& stats);
 
 nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorStats& stats,
