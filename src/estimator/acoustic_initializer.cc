@@ -241,6 +241,17 @@ std::optional<InitialState> AcousticInitializer::Solve(const ImuBuffer& imu, int
     on_path[worst].kept = false;
     --kept;
   }
+  // Most fixes left out is no multipath (a few per cent of the replies): the fixes and the DVL's
+  // path disagree as a whole (a DVL whose frame is not its T_B_S, turned 180 deg about z say,
+  // against a measured heading; fixes in another frame than D). No start rather than one on the
+  // two fixes that happen to agree with the wrong path.
+  const int left_out = n_on_path - kept;
+  if (left_out >= 3 && left_out > kept) {
+    return fail(std::to_string(left_out) + " of " + std::to_string(n_on_path) +
+                " fixes disagree with the DVL's path" +
+                (measured_psi ? " under the measured heading" : std::string()) +
+                ": check the DVL's frame (T_B_S) and the fixes' frame");
+  }
   if (!measured_psi && !(fit.lever_information > 0.0)) return fail("the vehicle has not moved");
   const double fit_heading_sigma =
       measured_psi ? heading_sensor_->sigma_rad : 1.0 / std::sqrt(fit.lever_information);

@@ -24,11 +24,13 @@ namespace {
 // A navigator's log: the simulator's dataset (duration_s of the default approach, from
 // detections) with its cameras, and without with_fixes its acoustic sensor, taken out of the
 // calibration. Returns the dataset folder.
-std::string NavigatorsLog(const test::TempDir& tmp, double duration_s, bool with_fixes) {
+// extra_scenario: more scenario keys (e.g. a heading sensor).
+std::string NavigatorsLog(const test::TempDir& tmp, double duration_s, bool with_fixes,
+                          const std::string& extra_scenario = "") {
   const std::string scenario = tmp / "nav.yaml";
   test::WriteTextFile(scenario, "name: nav\nduration_s: " + std::to_string(duration_s) +
                                     "\ndock: " + test::SourcePath("data/docks/t_shape.yaml") +
-                                    "\n");
+                                    "\n" + extra_scenario);
   const std::string dataset = tmp / "nav";
   EXPECT_EQ(test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset,
                               "--detections-only", "--quiet"})
@@ -162,6 +164,27 @@ TEST(WithoutCamerasCli, AWindowThatRefusesEveryFixRestartsFromThem) {
   }
   EXPECT_LT(best_dt, 0.01);
   EXPECT_LT(std::hypot(x - truth_x, y - truth_y), 0.3) << last;
+}
+
+// A DVL mounted turned 180 deg about z from what its T_B_S says, with a heading sensor: the
+// acoustic start finds most fixes off the DVL's path under the measured heading and refuses to
+// start, every frame NO-GO with that reason, instead of a start on the two fixes that agree.
+TEST(WithoutCamerasCli, ADvlInTheWrongFrameIsNoStart) {
+  test::TempDir tmp;
+  const std::string dataset =
+      NavigatorsLog(tmp, 30.0, /*with_fixes=*/true, "heading: {rate_hz: 10.0, sigma_deg: 2.0}\n");
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  YAML::Node calibration = YAML::LoadFile(dataset + "/calibration.yaml");
+  YAML::Node T = calibration["dvl"]["T_B_S"];
+  for (const int k : {0, 1, 2, 4, 5, 6}) T[k] = -T[k].as<double>();  // R_z(180 deg) R
+  YAML::Emitter out;
+  out << calibration;
+  test::WriteTextFile(dataset + "/calibration.yaml", out.c_str());
+  const auto r = test::RunAuvdock({"run", "--dataset", dataset, "--out", tmp / "out", "--quiet"});
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr(": 0 estimates"));
+  EXPECT_THAT(test::ReadTextFile(tmp / "out/decisions.csv"),
+              HasSubstr("disagree with the DVL's path under the measured heading"));
 }
 
 }  // namespace

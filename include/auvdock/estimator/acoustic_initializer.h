@@ -19,7 +19,9 @@
 //   psi = atan2(sum w_i g . (a_i x e_i), sum w_i a_i . e_i),    c = b_bar - R_g(psi) d_bar
 // (weighted 2-D Procrustes); the lever arm is taken at psi = 0 first, then at the fitted psi.
 // A fix whose residual r_i = b_i - c - R_g(psi) d_i has |r_i|^2 / sigma_i^2 above gate_chi2
-// (3 dof) is an outlier (multipath): the worst is dropped and the fit repeated.
+// (3 dof) is an outlier (multipath): the worst is dropped and the fit repeated. When that leaves
+// out more fixes than it keeps (at least 3), the fixes and the path disagree as a whole (a DVL
+// turned from its T_B_S, fixes in another frame): no state, with that reason.
 //
 // The state at t (a frame's time, after the last DVL sample: extrapolated at its velocity):
 //   R_D_B = R_g(psi) R_W_B(t),  p_D = b_bar + R_g(psi) (d(t) - d_bar),  v_D = R_D_B v_B(last)
@@ -47,9 +49,10 @@
 // axis: the window's next fixes then pull it to the truth whether the first was good or not (a
 // confident start on an outlier would gate the good fixes after it). One fix is not the default:
 // a single 0.2 m fix breaks the long approach's error target more often than two, and the earlier
-// start met a DVL rate test still locked by the start's tilt (README, "A heading sensor"). Fixes and DVL samples older than max_span_s before
-// the newest fix are forgotten; so is everything before a DVL gap (bottom lock lost, a stop)
-// longer than max_dvl_gap_s, since the path cannot be traced across it.
+// start met a DVL rate test still locked by the start's tilt (README, "A heading sensor"). Fixes
+// and DVL samples older than max_span_s before the newest fix are forgotten; so is everything
+// before a DVL gap (bottom lock lost, a stop) longer than max_dvl_gap_s, since the path cannot be
+// traced across it.
 //
 // Units: metres, radians, seconds; time stamps in ns.
 #pragma once
