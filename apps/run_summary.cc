@@ -71,6 +71,9 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
   if (const std::string dvl = DvlDisagreementWarning(stats); !dvl.empty()) {
     summary["warnings"].push_back(dvl);
   }
+  if (const std::string usbl = UsblDisagreementWarning(stats); !usbl.empty()) {
+    summary["warnings"].push_back(usbl);
+  }
   summary["adaptive_variance_factor"] = {{"mono", stats.mono_variance_factor},
                                          {"stereo", stats.stereo_variance_factor},
                                          {"dvl", stats.dvl_variance_factor},
@@ -131,9 +134,17 @@ std::string DvlDisagreementWarning(const EstimatorStats& stats) {
          "DVL's frame (calibration T_B_S) and its time stamps";
 }
 
+std::string UsblDisagreementWarning(const EstimatorStats& stats) {
+  const int samples = stats.usbl_used + stats.usbl_gated;
+  if (samples < 10 || 2 * stats.usbl_gated <= samples) return {};
+  return "the gate refused " + std::to_string(stats.usbl_gated) + " of " + std::to_string(samples) +
+         " acoustic fixes: they disagree with the lights and the other sensors; check that "
+         "the fixes are in the dock frame D (its origin, its axes, the dock's heading)";
+}
+
 void PrintDepthDisagreement(const char* command, const EstimatorStats& stats) {
-  for (const std::string& warning :
-       {DepthDisagreementWarning(stats), DvlDisagreementWarning(stats)}) {
+  for (const std::string& warning : {DepthDisagreementWarning(stats), DvlDisagreementWarning(stats),
+                                     UsblDisagreementWarning(stats)}) {
     if (!warning.empty()) {
       std::fprintf(stderr, "auvdock: %s: warning: %s\n", command, warning.c_str());
     }

@@ -51,7 +51,11 @@ std::string DepthDisagreementWarning(const EstimatorStats& stats);
 // heading the other way to the acoustic start: nothing refuses it, the position holds and the
 // heading is 180 deg off (simulated: 0.09 m, 3.09 rad); no warning can tell.
 std::string DvlDisagreementWarning(const EstimatorStats& stats);
-// Both warnings on stderr, when there are any.
+// The same for the acoustic fixes: the gate refused more than half of at least 10 (fixes in
+// another frame than D, converted from a beacon that is not where the dock is, while the lights
+// hold the state; without lights a divergence restarts from the fixes instead).
+std::string UsblDisagreementWarning(const EstimatorStats& stats);
+// The three warnings on stderr, when there are any.
 void PrintDepthDisagreement(const char* command, const EstimatorStats& stats);
 
 nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorStats& stats,

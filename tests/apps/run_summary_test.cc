@@ -30,6 +30,13 @@ TEST(RunSummary, SensorDisagreementWarnings) {
   EXPECT_THAT(DepthDisagreementWarning(stats), HasSubstr("rejected 6 of 21 depth samples"));
   stats.depth_offset_m = 0.3;  // estimated: the gate's refusals are the sensor's business
   EXPECT_EQ(DepthDisagreementWarning(stats), "");
+
+  stats.usbl_used = 4;
+  stats.usbl_gated = 5;  // 9 fixes: too few
+  EXPECT_EQ(UsblDisagreementWarning(stats), "");
+  stats.usbl_gated = 6;
+  EXPECT_THAT(UsblDisagreementWarning(stats), HasSubstr("refused 6 of 10 acoustic fixes"));
+  EXPECT_THAT(UsblDisagreementWarning(stats), HasSubstr("dock frame D"));
 }
 
 }  // namespace
