@@ -1,7 +1,9 @@
 // Sliding-window factor-graph estimator (fixed-lag smoother) of the vehicle's pose in the dock
 // frame, on Ceres: the heart of auvdock.
 //
-// States live at camera frames: x_k = (T_D_B, v_D, b_g, b_a) (layout in factors/pose_manifold.h).
+// States live at camera frames (on a log without cameras, at a steady rate: estimator/
+// state_times.h): x_k = (T_D_B, v_D, b_g, b_a) (layout in factors/pose_manifold.h), and, when
+// estimated, the DVL's bias b_S (estimate_dvl_bias, on by default) and the depth sensor's offset.
 // The cost over the window of the last N states is
 //   |r_prior|^2                                      marginalization prior (or the initial priors)
 // + sum_k |r_imu(x_k, x_k+1)|^2                      IMU preintegration between consecutive states
@@ -10,6 +12,7 @@
 // + sum_depth |r_depth|^2                            pressure depth against the dock's depth
 //   (+ sum_k |r_offset(b_k, b_k+1)|^2                 its offset's random walk, when estimated)
 // + sum_dvl |r_dvl|^2                                DVL velocity over ground, in its frame
+//   (+ sum_k |r_walk(b_S,k, b_S,k+1)|^2                with its bias b_S, a random walk)
 // + USBL fixes, SBL ranges, AHRS/compass headings      (estimator/sensor_factors.h)
 // where every r is whitened by its own noise model (pixel noise, triangulation covariance,
 // preintegrated IMU covariance), rho is a Huber loss, and w are the stage weights
@@ -27,6 +30,10 @@
 // Depth and DVL samples (AddDepth, AddDvl) join the state at or before their time
 // (estimator/sensor_factors.h).
 //
+// The IMU factors carry the Earth's rotation when the dock gives its latitude
+// (geometry/dock_model.h EarthRate_D). A start the user gives (SetStartState: an INS's output)
+// comes before the two starts below. A window that refuses most of the agreeing acoustic fixes
+// with no light in use is reset and restarted from them (divergence_fixes).
 // Initialisation: at the first frame with a per-frame pose (VisionFrame::T_D_B_initial): that
 // pose, zero velocity and zero biases, each with a prior (EstimatorOptions), unless the pose's
 // tilt disagrees with the accelerometer (init_max_tilt_error_rad). The attitude then refines
