@@ -111,7 +111,7 @@ void Run(const RunOptions& options) {
     std::printf("  no vision: %d frames: %s\n", count, reason.c_str());
   }
   PrintSymmetryUnresolved("run", counters.symmetry_unresolved);
-  PrintDepthDisagreement("run", estimator.stats());
+  PrintSensorDisagreements("run", estimator.stats());
   PrintGivenIdentities(source);
   std::printf("  per frame: decode %.2f ms, front-end %.2f ms, back-end %.2f ms\n",
               1e3 * source.decode_s() / counters.frames,

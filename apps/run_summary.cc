@@ -142,7 +142,7 @@ std::string UsblDisagreementWarning(const EstimatorStats& stats) {
          "the fixes are in the dock frame D (its origin, its axes, the dock's heading)";
 }
 
-void PrintDepthDisagreement(const char* command, const EstimatorStats& stats) {
+void PrintSensorDisagreements(const char* command, const EstimatorStats& stats) {
   for (const std::string& warning : {DepthDisagreementWarning(stats), DvlDisagreementWarning(stats),
                                      UsblDisagreementWarning(stats)}) {
     if (!warning.empty()) {

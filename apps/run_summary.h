@@ -42,7 +42,8 @@ void PrintGivenIdentities(const VisionFrameSource& source);
 // more than a quarter of at least 20 samples: the depth disagrees with the other sensors, the
 // sign of a sensor whose zero is not the dock survey's (on the default scenario with an offset
 // of 0.3 m, 80-85 % of the samples are gated; without one, at most 1 %). The warning's text, or
-// empty. MakeRunSummary puts it in "warnings"; PrintDepthDisagreement on stderr.
+// empty. MakeRunSummary puts it in "warnings"; PrintSensorDisagreements on stderr (with the
+// DVL's and the fixes' below).
 std::string DepthDisagreementWarning(const EstimatorStats& stats);
 // The same for the DVL: its rate test, admission and gate refused more than half of at least 20
 // samples (a DVL in another frame than its T_B_S says, rotated 180 deg about z say, or on
@@ -56,7 +57,7 @@ std::string DvlDisagreementWarning(const EstimatorStats& stats);
 // hold the state; without lights a divergence restarts from the fixes instead).
 std::string UsblDisagreementWarning(const EstimatorStats& stats);
 // The three warnings on stderr, when there are any.
-void PrintDepthDisagreement(const char* command, const EstimatorStats& stats);
+void PrintSensorDisagreements(const char* command, const EstimatorStats& stats);
 
 nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorStats& stats,
                               const std::vector<std::string>& skipped_rows,

@@ -161,7 +161,7 @@ void Smooth(const SmoothOptions& options) {
     std::printf("  no vision: %d frames: %s\n", count, reason.c_str());
   }
   PrintSymmetryUnresolved("smooth", counters.symmetry_unresolved);
-  PrintDepthDisagreement("smooth", stats);
+  PrintSensorDisagreements("smooth", stats);
   PrintGivenIdentities(source);
 }
 

@@ -262,15 +262,14 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   problem_options.enable_fast_removal = true;
   ceres::Problem problem(problem_options);
   const PoseManifold manifold;
-  const bool with_depth_offset = EstimatesDepthOffset(estimator_options, calibration);
-  const bool with_dvl_bias = EstimatesDvlBias(estimator_options, calibration);
-  const OptionalBlocks with{with_depth_offset, with_dvl_bias};
+  const OptionalBlocks with{EstimatesDepthOffset(estimator_options, calibration),
+                            EstimatesDvlBias(estimator_options, calibration)};
   for (size_t k = 0; k < states.size(); ++k) {
     BatchState* s = states[k].get();
     problem.AddParameterBlock(s->pose, kPoseSize, const_cast<PoseManifold*>(&manifold));
     problem.AddParameterBlock(s->velocity, kVelocitySize);
     problem.AddParameterBlock(s->bias, kBiasSize);
-    if (with_dvl_bias) {
+    if (with.dvl_bias) {
       // The DVL's bias along the whole log, drifting as a random walk; its prior at the start.
       problem.AddParameterBlock(s->dvl_bias, kDvlBiasSize);
       if (k == 0) {
@@ -285,7 +284,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
                                  nullptr, states[k - 1]->dvl_bias, s->dvl_bias);
       }
     }
-    if (with_depth_offset) {
+    if (with.depth_offset) {
       // One offset along the whole log, drifting as a random walk; its prior at the start.
       problem.AddParameterBlock(s->depth_offset, kDepthOffsetSize);
       if (k == 0) {
@@ -334,8 +333,8 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
   };
   const auto blocks_of = [&](BatchState* s) {
     return StateBlocks(s->pose, s->velocity, &buffer, BiasFromBlock(s->bias),
-                       with_depth_offset ? s->depth_offset : nullptr,
-                       with_dvl_bias ? s->dvl_bias : nullptr);
+                       with.depth_offset ? s->depth_offset : nullptr,
+                       with.dvl_bias ? s->dvl_bias : nullptr);
   };
   std::vector<SensorResidual> depth_residuals;
   if (estimator_options.use_depth && calibration.depth) {
@@ -541,7 +540,7 @@ BatchResult SmoothBatch(const Calibration& calibration, const DockModel& dock,
     out.T_D_B = PoseFromBlock(s->pose);
     out.v_D = Eigen::Map<const Eigen::Vector3d>(s->velocity);
     out.bias = BiasFromBlock(s->bias);
-    if (with_depth_offset) {
+    if (with.depth_offset) {
       out.depth_offset_m = s->depth_offset[0];
       if (offset_variances[k] >= 0.0) out.depth_offset_sigma_m = std::sqrt(offset_variances[k]);
     }

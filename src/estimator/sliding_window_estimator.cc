@@ -124,6 +124,7 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
   rig_.dock = &dock_;
   depth_offset_on_ = EstimatesDepthOffset(options_, calibration_);
   dvl_bias_on_ = EstimatesDvlBias(options_, calibration_);
+  earth_rate_D_ = EarthRate_D(dock_);
   Reset("");
   stats_.resets = 0;
   stats_.log.clear();
@@ -249,7 +250,7 @@ bool SlidingWindowEstimator::InitializeFromGivenStart(int64_t t_ns) {
     nav.q_D_B = start.T_D_B.q;
     nav.p_D = start.T_D_B.p;
     nav.v_D = start.v_D;
-    const NavState at_frame = pim->Predict(nav, ImuBias(), dock_.gravity_D, EarthRate_D(dock_));
+    const NavState at_frame = pim->Predict(nav, ImuBias(), dock_.gravity_D, earth_rate_D_);
     start.T_D_B = Pose3(at_frame.q_D_B, at_frame.p_D);
     start.v_D = at_frame.v_D;
   }
@@ -346,7 +347,7 @@ bool SlidingWindowEstimator::AddState(int64_t t_ns) {
   nav.q_D_B = previous_pose.q;
   nav.p_D = previous_pose.p;
   nav.v_D = Eigen::Map<const Eigen::Vector3d>(previous.velocity);
-  const NavState predicted = pim->Predict(nav, bias, dock_.gravity_D, EarthRate_D(dock_));
+  const NavState predicted = pim->Predict(nav, bias, dock_.gravity_D, earth_rate_D_);
   PoseToBlock(Pose3(predicted.q_D_B, predicted.p_D), state->pose);
   Eigen::Map<Eigen::Vector3d>(state->velocity) = predicted.v_D;
   std::copy(previous.bias, previous.bias + kBiasSize, state->bias);
@@ -354,9 +355,9 @@ bool SlidingWindowEstimator::AddState(int64_t t_ns) {
   problem_->AddParameterBlock(state->pose, kPoseSize, pose_manifold_.get());
   problem_->AddParameterBlock(state->velocity, kVelocitySize);
   problem_->AddParameterBlock(state->bias, kBiasSize);
-  problem_->AddResidualBlock(
-      ImuPreintegrationFactor::Create(*pim, dock_.gravity_D, EarthRate_D(dock_)), nullptr,
-      previous.pose, previous.velocity, previous.bias, state->pose, state->velocity, state->bias);
+  problem_->AddResidualBlock(ImuPreintegrationFactor::Create(*pim, dock_.gravity_D, earth_rate_D_),
+                             nullptr, previous.pose, previous.velocity, previous.bias, state->pose,
+                             state->velocity, state->bias);
   if (dvl_bias_on_) {
     std::copy(previous.dvl_bias, previous.dvl_bias + kDvlBiasSize, state->dvl_bias);
     problem_->AddParameterBlock(state->dvl_bias, kDvlBiasSize);
@@ -1060,7 +1061,7 @@ std::optional<Pose3> SlidingWindowEstimator::PropagatedPose(int64_t t_ns) const 
   nav.q_D_B = T.q;
   nav.p_D = T.p;
   nav.v_D = Eigen::Map<const Eigen::Vector3d>(newest.velocity);
-  const NavState predicted = pim->Predict(nav, bias, dock_.gravity_D, EarthRate_D(dock_));
+  const NavState predicted = pim->Predict(nav, bias, dock_.gravity_D, earth_rate_D_);
   return Pose3(predicted.q_D_B, predicted.p_D);
 }
 

@@ -11,7 +11,6 @@
 
 #include "tests/testing/run_command.h"
 #include "tests/testing/temp_dir.h"
-#include "tests/testing/test_scenarios.h"
 
 using ::testing::HasSubstr;
 
@@ -20,14 +19,7 @@ namespace {
 
 TEST(FixesOffCli, LightsAreBelievedAndTheFixesWarnedOf) {
   test::TempDir tmp;
-  const std::string scenario = tmp / "lit.yaml";
-  test::WriteTextFile(scenario, "name: lit\nduration_s: 30.0\ndock: " +
-                                    test::SourcePath("data/docks/t_shape.yaml") + "\n");
-  const std::string dataset = tmp / "lit";
-  ASSERT_EQ(test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset,
-                              "--detections-only", "--quiet"})
-                .exit_status,
-            0);
+  const std::string dataset = test::SimulateDetections(tmp.path(), "lit", 30.0);
   // Every fix 50 m along D's x.
   std::istringstream in(test::ReadTextFile(dataset + "/usbl0/data.csv"));
   std::string line, shifted;

@@ -27,15 +27,8 @@ namespace {
 // extra_scenario: more scenario keys (e.g. a heading sensor).
 std::string NavigatorsLog(const test::TempDir& tmp, double duration_s, bool with_fixes,
                           const std::string& extra_scenario = "") {
-  const std::string scenario = tmp / "nav.yaml";
-  test::WriteTextFile(scenario, "name: nav\nduration_s: " + std::to_string(duration_s) +
-                                    "\ndock: " + test::SourcePath("data/docks/t_shape.yaml") +
-                                    "\n" + extra_scenario);
-  const std::string dataset = tmp / "nav";
-  EXPECT_EQ(test::RunAuvdock({"simulate", "--scenario", scenario, "--out", dataset,
-                              "--detections-only", "--quiet"})
-                .exit_status,
-            0);
+  const std::string dataset =
+      test::SimulateDetections(tmp.path(), "nav", duration_s, extra_scenario);
   YAML::Node calibration = YAML::LoadFile(dataset + "/calibration.yaml");
   calibration.remove("cameras");
   if (!with_fixes) calibration.remove("acoustic");
@@ -43,6 +36,16 @@ std::string NavigatorsLog(const test::TempDir& tmp, double duration_s, bool with
   out << calibration;
   test::WriteTextFile(dataset + "/calibration.yaml", out.c_str());
   return dataset;
+}
+
+// A --start file: the pose and velocity given, sigmas 0.1 m, 0.5 deg tilt, 1 deg heading,
+// 0.05 m/s, at the simulator's first IMU sample.
+void WriteStart(const std::string& path, const std::string& p_D, const std::string& rpy_deg,
+                const std::string& v_D) {
+  test::WriteTextFile(path, "t_ns: 1700000000000000000\np_D: [" + p_D + "]\nrpy_deg: [" + rpy_deg +
+                                "]\nv_D: [" + v_D +
+                                "]\nposition_sigma_m: 0.1\ntilt_sigma_deg: 0.5\n"
+                                "heading_sigma_deg: 1.0\nvelocity_sigma_mps: 0.05\n");
 }
 
 TEST(WithoutCamerasCli, RunAndSmoothMakeTheirOwnStates) {
@@ -86,12 +89,8 @@ TEST(WithoutCamerasCli, AGivenStartStartsTheWindow) {
   // The simulator's first true state (t = its first IMU sample): roll, pitch, yaw of
   // q = (0.99660, -0.00092, 0.01121, 0.08162) and its velocity.
   const std::string start = tmp / "start.yaml";
-  test::WriteTextFile(start,
-                      "t_ns: 1700000000000000000\np_D: [-8.0, 1.0738800516653348, "
-                      "-4.428703411195086]\nrpy_deg: [0.0, 1.2884, 9.3639]\n"
-                      "v_D: [0.49613893835683387, 0.026255517880197796, 0.038000379807131134]\n"
-                      "position_sigma_m: 0.1\ntilt_sigma_deg: 0.5\nheading_sigma_deg: 1.0\n"
-                      "velocity_sigma_mps: 0.05\n");
+  WriteStart(start, "-8.0, 1.0738800516653348, -4.428703411195086", "0.0, 1.2884, 9.3639",
+             "0.49613893835683387, 0.026255517880197796, 0.038000379807131134");
   const auto with = test::RunAuvdock(
       {"run", "--dataset", dataset, "--out", tmp / "with", "--quiet", "--start", start});
   ASSERT_EQ(with.exit_status, 0) << with.err;
@@ -124,11 +123,7 @@ TEST(WithoutCamerasCli, AWindowThatRefusesEveryFixRestartsFromThem) {
   const std::string dataset = NavigatorsLog(tmp, 30.0, /*with_fixes=*/true);
   ASSERT_FALSE(::testing::Test::HasFailure());
   const std::string start = tmp / "start.yaml";
-  test::WriteTextFile(start,
-                      "t_ns: 1700000000000000000\np_D: [12.0, 1.07, -4.43]\n"
-                      "rpy_deg: [0.0, 1.2884, 9.3639]\nv_D: [0.496, 0.026, 0.038]\n"
-                      "position_sigma_m: 0.1\ntilt_sigma_deg: 0.5\nheading_sigma_deg: 1.0\n"
-                      "velocity_sigma_mps: 0.05\n");
+  WriteStart(start, "12.0, 1.07, -4.43", "0.0, 1.2884, 9.3639", "0.496, 0.026, 0.038");
   const auto r = test::RunAuvdock(
       {"run", "--dataset", dataset, "--out", tmp / "out", "--quiet", "--start", start});
   ASSERT_EQ(r.exit_status, 0) << r.err;

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "tests/testing/temp_dir.h"
+#include "tests/testing/test_scenarios.h"
 
 namespace auvdock::test {
 
@@ -77,6 +78,19 @@ CommandResult RunAuvdockAndSignalWhen(const std::vector<std::string>& args,
                                       const std::function<bool()>& ready, int signal,
                                       double timeout_s) {
   return Run(args, 0.0, signal, ready, timeout_s);
+}
+
+std::string SimulateDetections(const std::string& folder, const std::string& name,
+                               double duration_s, const std::string& extra_scenario) {
+  const std::string scenario = folder + "/" + name + ".yaml";
+  WriteTextFile(scenario, "name: " + name + "\nduration_s: " + std::to_string(duration_s) +
+                              "\ndock: " + SourcePath("data/docks/t_shape.yaml") + "\n" +
+                              extra_scenario);
+  const std::string dataset = folder + "/" + name;
+  const CommandResult r = RunAuvdock(
+      {"simulate", "--scenario", scenario, "--out", dataset, "--detections-only", "--quiet"});
+  if (r.exit_status != 0) throw std::runtime_error("simulate " + scenario + ": " + r.err);
+  return dataset;
 }
 
 }  // namespace auvdock::test

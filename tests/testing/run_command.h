@@ -25,4 +25,11 @@ CommandResult RunAuvdockAndSignalWhen(const std::vector<std::string>& args,
                                       const std::function<bool()>& ready, int signal,
                                       double timeout_s = 60.0);
 
+// `simulate --detections-only` of the default approach on the T-shaped dock for duration_s,
+// with extra_scenario's keys appended to the scenario (e.g. a heading sensor): the scenario in
+// folder/name.yaml, the dataset in folder/name, whose path it returns. Throws std::runtime_error
+// with the command's stderr when the simulation fails.
+std::string SimulateDetections(const std::string& folder, const std::string& name,
+                               double duration_s, const std::string& extra_scenario = "");
+
 }  // namespace auvdock::test

@@ -584,6 +584,8 @@ class SlidingWindowEstimator {
   bool depth_offset_on_ = false;
   // estimate_dvl_bias with a DVL in use: every state has its DVL-bias block.
   bool dvl_bias_on_ = false;
+  // The Earth's rotation in D (EarthRate_D of the dock; zero without its latitude).
+  Eigen::Vector3d earth_rate_D_ = Eigen::Vector3d::Zero();
   std::string init_refusal_;
   std::optional<InitialState> given_start_;    // SetStartState, until applied
   // The gate's verdicts on the latest fixes (true: refused), with the time of the frame that
