@@ -65,6 +65,7 @@
 #include "apps/help_text.h"
 #include "apps/reason_class.h"
 #include "apps/signal_flag.h"
+#include "apps/vision_frame_source.h"
 #include "auvdock/eval/detection_evaluation.h"
 #include "auvdock/io/camera_file.h"
 #include "auvdock/io/csv.h"
@@ -102,6 +103,8 @@ struct DetectOptions {
   std::vector<double> gravity_camera;
   double min_halo_excess = -1.0;  // < 0: learned from the identified lights
   double label_max_range_m = -1.0;  // < 0: every ok label is required
+  std::string detector = "blob";
+  std::string detector_model;  // empty: the shipped one
 };
 
 
@@ -290,6 +293,15 @@ void RunDetect(const DetectOptions& options) {
   MonoLightPipelineOptions pipeline_options;
   pipeline_options.detector.deinterlace = options.deinterlace;
   pipeline_options.detector.checks.colour = colour;
+  if (options.detector == "learned") {
+    pipeline_options.learned_first_pass = true;
+    pipeline_options.learned.model_path =
+        options.detector_model.empty() ? DefaultLightNetModel() : options.detector_model;
+    pipeline_options.learned.colour = colour;
+    pipeline_options.learned.deinterlace = options.deinterlace;
+  } else if (options.detector != "blob") {
+    throw InputError("--detector: expected blob or learned (got '" + options.detector + "')");
+  }
   if (options.min_halo_excess >= 0.0) {
     pipeline_options.detector.checks.min_halo_excess = options.min_halo_excess;
     pipeline_options.learn_colour = false;
@@ -611,6 +623,14 @@ void AddDetectCommand(CLI::App& root) {
   sub->add_flag("--overlay", options->overlay, "Write each image with the detections drawn");
   sub->add_flag("--deinterlace", options->deinterlace,
                 "Interlaced video: detect on the even field, line-doubled");
+  sub->add_option("--detector", options->detector,
+                  "blob (default: scale-space blobs and checks) or learned (the network learned "
+                  "from randomised renders proposes the lights: learned_light_detector.h)")
+      ->check(CLI::IsMember({"blob", "learned"}));
+  sub->add_option("--detector-model", options->detector_model,
+                  "The learned detector's ONNX file (default: the shipped " +
+                      DefaultLightNetModel() + ")")
+      ->check(CLI::ExistingFile);
   sub->add_flag("--no-tracking", options->no_tracking, "Identify every image from scratch (and no --bridge)");
   sub->add_flag("--keep-unexplained", options->keep_unexplained,
                 "Report as detections what an image's pose leaves unidentified far from every "

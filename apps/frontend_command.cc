@@ -28,6 +28,7 @@
 #include "apps/image_prefetcher.h"
 #include "apps/reason_class.h"
 #include "apps/signal_flag.h"
+#include "apps/vision_frame_source.h"
 #include "auvdock/io/csv.h"
 #include "auvdock/io/dataset.h"
 #include "auvdock/io/detections_csv.h"
@@ -50,6 +51,7 @@ struct FrontendOptions {
   bool no_tracking = false;
   std::string matcher = "ransac";
   std::string detector = "contrast";
+  std::string detector_model;  // --detector-model; empty: the shipped one
   bool quiet = false;
 };
 
@@ -62,11 +64,9 @@ void RunFrontend(const FrontendOptions& options) {
   PaperBaselineOptions pipeline_options;
   pipeline_options.detector.dehaze = options.dehaze;
   pipeline_options.use_tracking = !options.no_tracking;
-  if (options.detector == "blob") {
-    pipeline_options.detector_kind = LightDetectorKind::kBlob;
-  } else if (options.detector != "contrast") {
-    throw InputError("--detector: expected contrast or blob (got '" + options.detector + "')");
-  }
+  pipeline_options.detector_kind = ParseDetectorKind(options.detector);
+  pipeline_options.learned_detector.model_path =
+      options.detector_model.empty() ? DefaultLightNetModel() : options.detector_model;
   if (options.matcher == "omnidirectional") {
     pipeline_options.matcher = BaselineMatcher::kOmnidirectional;
   } else if (options.matcher != "ransac") {
@@ -200,9 +200,14 @@ void AddFrontendCommand(CLI::App& root) {
   sub->add_option("--matcher", options->matcher, "ransac (default) or omnidirectional")
       ->check(CLI::IsMember({"ransac", "omnidirectional"}));
   sub->add_option("--detector", options->detector,
-                  "contrast (default: developed on our renders) or blob (real water: "
-                  "blob_light_detector.h, the dock's colour)")
-      ->check(CLI::IsMember({"contrast", "blob"}));
+                  "contrast (default: developed on our renders), blob (real water: "
+                  "blob_light_detector.h, the dock's colour) or learned (the network learned "
+                  "from randomised renders: learned_light_detector.h)")
+      ->check(CLI::IsMember({"contrast", "blob", "learned"}));
+  sub->add_option("--detector-model", options->detector_model,
+                  "The learned detector's ONNX file (default: the shipped " +
+                      DefaultLightNetModel() + ")")
+      ->check(CLI::ExistingFile);
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { RunFrontend(*options); });
 }

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <string>
 
+#include "apps/data_files.h"
 #include "apps/reason_class.h"
 #include "auvdock/estimator/state_times.h"
 #include "auvdock/estimator/vision_frame_builder.h"
@@ -20,9 +21,10 @@
 namespace auvdock::cli {
 namespace {
 
-PaperBaselineOptions PipelineOptions(LightDetectorKind detector) {
+PaperBaselineOptions PipelineOptions(LightDetectorKind detector, const std::string& model) {
   PaperBaselineOptions options;
   options.detector_kind = detector;
+  options.learned_detector.model_path = model.empty() ? DefaultLightNetModel() : model;
   return options;
 }
 
@@ -81,8 +83,11 @@ bool FileExists(const std::string& path) { return std::filesystem::is_regular_fi
 LightDetectorKind ParseDetectorKind(const std::string& name) {
   if (name == "contrast") return LightDetectorKind::kContrast;
   if (name == "blob") return LightDetectorKind::kBlob;
-  throw InputError("--detector: expected contrast or blob (got '" + name + "')");
+  if (name == "learned") return LightDetectorKind::kLearned;
+  throw InputError("--detector: expected contrast, blob or learned (got '" + name + "')");
 }
+
+std::string DefaultLightNetModel() { return DataPath("models/light_net.onnx"); }
 
 int64_t SyncToleranceNs(double milliseconds) {
   if (!std::isfinite(milliseconds) || milliseconds > 1e6) {
@@ -94,8 +99,13 @@ int64_t SyncToleranceNs(double milliseconds) {
 void AddFrameSourceOptions(CLI::App* sub, FrameSourceOptions* options,
                            const std::string& detections_help) {
   sub->add_option("--detector", options->detector,
-                  "contrast (default: developed on our renders) or blob (real water)")
-      ->check(CLI::IsMember({"contrast", "blob"}));
+                  "contrast (default: developed on our renders), blob (real water) or learned "
+                  "(the network learned from randomised renders)")
+      ->check(CLI::IsMember({"contrast", "blob", "learned"}));
+  sub->add_option("--detector-model", options->detector_model,
+                  "The learned detector's ONNX file (default: the shipped " +
+                      DefaultLightNetModel() + ")")
+      ->check(CLI::ExistingFile);
   sub->add_option("--sync-tolerance-ms", options->sync_tolerance_ms,
                   "Images of different cameras this close in time share one state (default: half "
                   "the shortest frame interval; 0: equal time stamps only)")
@@ -110,12 +120,13 @@ void AddFrameSourceOptions(CLI::App* sub, FrameSourceOptions* options,
 VisionFrameSource::VisionFrameSource(const Dataset& dataset, const FrameSourceOptions& options)
     : VisionFrameSource(dataset, ParseDetectorKind(options.detector),
                         SyncToleranceNs(options.sync_tolerance_ms), options.detections,
-                        options.state_rate_hz) {}
+                        options.state_rate_hz, options.detector_model) {}
 
 VisionFrameSource::VisionFrameSource(const Dataset& dataset, LightDetectorKind detector,
                                      int64_t sync_tolerance_ns, const std::string& detections_path,
-                                     double state_rate_hz)
-    : pipeline_(dataset.calibration, RequireDock(dataset), PipelineOptions(detector)) {
+                                     double state_rate_hz, const std::string& detector_model)
+    : pipeline_(dataset.calibration, RequireDock(dataset),
+                PipelineOptions(detector, detector_model)) {
   cameras_ = {pipeline_.left_camera(), pipeline_.right_camera(), pipeline_.mono_camera()};
   if (dataset.calibration.cameras.empty() && detections_path.empty()) {
     if (dataset.imu.size() < 2) {

@@ -43,8 +43,10 @@
 
 namespace auvdock::cli {
 
-// "contrast" or "blob" (the --detector option); throws InputError otherwise.
+// "contrast", "blob" or "learned" (the --detector option); throws InputError otherwise.
 LightDetectorKind ParseDetectorKind(const std::string& name);
+// The shipped model of the learned detector (data/models/light_net.onnx as the binary finds it).
+std::string DefaultLightNetModel();
 // The --sync-tolerance-ms option in ns: < 0 (the default) stays < 0; NaN/Inf throw InputError.
 int64_t SyncToleranceNs(double milliseconds);
 
@@ -54,6 +56,7 @@ struct FrameSourceOptions {
   double sync_tolerance_ms = -1.0;    // --sync-tolerance-ms; < 0: half the shortest interval
   std::string detections;             // --detections: replay this file instead of the images
   double state_rate_hz = 10.0;        // --state-rate-hz: states without cameras
+  std::string detector_model;         // --detector-model; empty: DefaultLightNetModel()
 };
 // Registers --detector, --sync-tolerance-ms and --detections (described by detections_help).
 void AddFrameSourceOptions(CLI::App* sub, FrameSourceOptions* options,
@@ -65,11 +68,13 @@ class VisionFrameSource {
   // when given, none), or when detections_path is malformed.
   // sync_tolerance_ns < 0: the default above; 0: only images with equal time stamps share a
   // frame. detections_path: replay that detections.csv instead of the images.
-  // state_rate_hz: the states' rate when the calibration has no camera.
+  // state_rate_hz: the states' rate when the calibration has no camera. detector_model: the
+  // learned detector's ONNX file (empty: DefaultLightNetModel()).
   explicit VisionFrameSource(const Dataset& dataset,
                              LightDetectorKind detector = LightDetectorKind::kContrast,
                              int64_t sync_tolerance_ns = -1,
-                             const std::string& detections_path = "", double state_rate_hz = 10.0);
+                             const std::string& detections_path = "", double state_rate_hz = 10.0,
+                             const std::string& detector_model = "");
   // The same, from the command line's options.
   VisionFrameSource(const Dataset& dataset, const FrameSourceOptions& options);
   VisionFrameSource(const VisionFrameSource&) = delete;  // its decoder refers to it

@@ -4,7 +4,8 @@
 Makes perturbed copies of labelled frames and measures `auvdock detect --labels` on each:
 a closer or farther view (zoom about the image centre, with the calibration's focal lengths and
 principal point changed to match: the distortion, in normalised coordinates, stays the same, so
-the poses stay comparable), exposure (gain), a tone curve (gamma), limited-range video levels
+the poses stay comparable), a shift (a fraction of the image's width and height; the principal
+point moves with it) that puts the dock against a border, exposure (gain), a tone curve (gamma), limited-range video levels
 (16-235 shown as full range), defocus blur, JPEG quality and sensor noise. The
 labels move with the zoom; a label the zoom pushes out of the image becomes `edge` (not
 required), one within the border margin `border`.
@@ -42,6 +43,12 @@ VARIANTS = {
     "blur1.2": {"blur": 1.2},
     "jpeg40": {"jpeg": 40},
     "noise6": {"noise": 6.0},
+    # The dock against the top border and closer, as late in an approach: shifted up by a third
+    # of the image's height (y of 576 px: 192 px), and with a zoom and a gain that merges the
+    # lights' glow into a white funnel.
+    "up0.33": {"shift": (0.0, -1.0 / 3.0)},
+    "zoom1.5up": {"zoom": 1.5, "shift": (0.0, -1.0 / 3.0)},
+    "gain1.4zoom1.5up": {"zoom": 1.5, "shift": (0.0, -1.0 / 3.0), "gain": 1.4},
 }
 
 
@@ -62,7 +69,7 @@ def read_labels(path):
     return rows
 
 
-def zoomed_calibration(text, zoom, centre, path):
+def zoomed_calibration(text, zoom, centre, shift, path):
     match = re.search(r"intrinsics:\s*\[([^\]]*)\]", text)
     if not match:
         fail(f"{path}: no 'intrinsics: [fx, fy, cx, cy]' (auvdock's calibration.yaml is needed)")
@@ -70,8 +77,8 @@ def zoomed_calibration(text, zoom, centre, path):
         fx, fy, cx, cy = (float(x) for x in match.group(1).split(","))
     except ValueError:
         fail(f"{path}: 'intrinsics' is not four numbers")
-    cx = zoom * (cx - centre[0]) + centre[0]
-    cy = zoom * (cy - centre[1]) + centre[1]
+    cx = zoom * (cx - centre[0]) + centre[0] + shift[0]
+    cy = zoom * (cy - centre[1]) + centre[1] + shift[1]
     return text.replace(
         match.group(0), f"intrinsics: [{zoom * fx:.4f}, {zoom * fy:.4f}, {cx:.4f}, {cy:.4f}]")
 
@@ -98,9 +105,12 @@ def make_variant(args, name, effect, labels, folder, cv2, np):
             shutil.copyfile(path, os.path.join(frames_dir, base))
             continue
         centre = ((size[0] - 1) / 2.0, (size[1] - 1) / 2.0)
+        shift = (effect.get("shift", (0.0, 0.0))[0] * size[0],
+                 effect.get("shift", (0.0, 0.0))[1] * size[1])
         work = image.astype(np.float32)
-        if zoom != 1.0:
-            warp = np.array([[zoom, 0, (1 - zoom) * centre[0]], [0, zoom, (1 - zoom) * centre[1]]])
+        if zoom != 1.0 or shift != (0.0, 0.0):
+            warp = np.array([[zoom, 0, (1 - zoom) * centre[0] + shift[0]],
+                             [0, zoom, (1 - zoom) * centre[1] + shift[1]]])
             work = cv2.warpAffine(work, warp, size, flags=cv2.INTER_LINEAR,
                                   borderMode=cv2.BORDER_REPLICATE)
         work *= effect.get("gain", 1.0)
@@ -121,6 +131,8 @@ def make_variant(args, name, effect, labels, folder, cv2, np):
     if size is None:
         fail("none of the images is labelled (frame_file names the image file)")
     centre = ((size[0] - 1) / 2.0, (size[1] - 1) / 2.0)
+    shift = (effect.get("shift", (0.0, 0.0))[0] * size[0],
+             effect.get("shift", (0.0, 0.0))[1] * size[1])
     margin = args.border_px * zoom
     with open(os.path.join(folder, "labels.csv"), "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=list(labels[0].keys()))
@@ -128,8 +140,8 @@ def make_variant(args, name, effect, labels, folder, cv2, np):
         for row in labels:
             row = dict(row)
             if row.get("u") and row.get("v"):
-                u = zoom * (float(row["u"]) - centre[0]) + centre[0]
-                v = zoom * (float(row["v"]) - centre[1]) + centre[1]
+                u = zoom * (float(row["u"]) - centre[0]) + centre[0] + shift[0]
+                v = zoom * (float(row["v"]) - centre[1]) + centre[1] + shift[1]
                 row["u"], row["v"] = f"{u:.3f}", f"{v:.3f}"
                 status = row.get("status", "ok")
                 if not (0 <= u < size[0] and 0 <= v < size[1]):
@@ -141,7 +153,7 @@ def make_variant(args, name, effect, labels, folder, cv2, np):
     with open(args.calib) as f:
         text = f.read()
     with open(os.path.join(folder, "calibration.yaml"), "w") as f:
-        f.write(zoomed_calibration(text, zoom, centre, args.calib))
+        f.write(zoomed_calibration(text, zoom, centre, shift, args.calib))
 
 
 def main():

@@ -61,6 +61,9 @@ MonoLightPipeline::MonoLightPipeline(const CameraCalibration& camera, const Dock
       dock_(dock),
       options_(options),
       detector_(options.detector),
+      learned_detector_(options.learned_first_pass
+                            ? std::make_shared<const LearnedLightDetector>(options.learned)
+                            : nullptr),
       weak_detector_(WeakOptions(options)),
       pose_search_(options.detector, options.guided),
       tracked_search_(options.detector, TrackedSearchOptions(options)),
@@ -73,7 +76,8 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
                                             : options_.detector.checks.min_halo_excess;
   const auto t0 = Clock::now();
   // 1. The whole image.
-  frame.detections = detector_.Detect(image, &frame.rejected, halo);
+  frame.detections = learned_detector_ ? learned_detector_->Detect(image)
+                                       : detector_.Detect(image, &frame.rejected, halo);
   frame.first_pass_detections = static_cast<int>(frame.detections.size());
   // 2. Where the tracked pose puts the lights that 1 did not find.
   const std::optional<Pose3> tracked = poser_.TrackedPose();

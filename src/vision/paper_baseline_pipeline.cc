@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "auvdock/vision/given_identity_check.h"
@@ -16,6 +17,24 @@ namespace {
 // The blob detector's options with the dock's light colour.
 BlobLightDetectorOptions WithDockColour(BlobLightDetectorOptions options, const DockModel& dock) {
   options.checks.colour = ParseLightColour(dock.light_colour);
+  return options;
+}
+
+BlobLightDetectorOptions WeakOptions(const PaperBaselineOptions& options, const DockModel& dock) {
+  if (!(options.weak_min_response > 0.0) ||
+      !(options.weak_halo_fraction >= 0.0 && options.weak_halo_fraction <= 1.0) ||
+      !(options.weak_min_support >= 0.0 && options.weak_min_support <= 1.0) ||
+      !(options.weak_min_view_elevation_deg >= 0.0 && options.weak_min_view_elevation_deg < 90.0)) {
+    throw std::invalid_argument("PaperBaselineOptions: weak pass out of range");
+  }
+  BlobLightDetectorOptions weak = WithDockColour(options.blob_detector, dock);
+  weak.candidates.min_response = std::min(weak.candidates.min_response, options.weak_min_response);
+  return weak;
+}
+
+LearnedLightDetectorOptions WithDockColour(LearnedLightDetectorOptions options,
+                                           const DockModel& dock) {
+  options.colour = ParseLightColour(dock.light_colour);
   return options;
 }
 
@@ -33,6 +52,11 @@ PaperBaselinePipeline::PaperBaselinePipeline(const Calibration& calibration, con
       options_(options),
       detector_(options.detector),
       blob_detector_(WithDockColour(options.blob_detector, dock)),
+      weak_detector_(WeakOptions(options, dock)),
+      learned_detector_(options.detector_kind == LightDetectorKind::kLearned
+                            ? std::make_shared<const LearnedLightDetector>(
+                                  WithDockColour(options.learned_detector, dock))
+                            : nullptr),
       guided_search_(WithDockColour(options.blob_detector, dock), options.guided),
       colour_learners_{HaloColourLearner(options.blob_detector.checks.min_halo_excess),
                        HaloColourLearner(options.blob_detector.checks.min_halo_excess),
@@ -275,6 +299,8 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
     if (!camera || image.empty()) return detections;
     if (options_.detector_kind == LightDetectorKind::kBlob) {
       detections = blob_detector_.Detect(image, nullptr, colour_learners_[index].threshold());
+    } else if (options_.detector_kind == LightDetectorKind::kLearned) {
+      detections = learned_detector_->Detect(image);
     } else {
       detections = detector_.Detect(image);
     }
@@ -282,7 +308,11 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
   };
   BaselineFrame frame = ProcessDetections(t_ns, detect(left_, left, 0), detect(right_, right, 1),
                                           detect(mono_, mono, 2), predicted_T_D_B);
-  if (options_.detector_kind == LightDetectorKind::kBlob) {
+  if (!frame.T_D_B && options_.weak_pass &&
+      options_.detector_kind != LightDetectorKind::kContrast) {
+    frame = WeakPass(std::move(frame), left, right, mono, predicted_T_D_B);
+  }
+  if (options_.detector_kind != LightDetectorKind::kContrast) {
     colour_learners_[0].Observe(frame.left.detections, frame.left.light_ids);
     colour_learners_[1].Observe(frame.right.detections, frame.right.light_ids);
     colour_learners_[2].Observe(frame.mono.detections, frame.mono.light_ids);
@@ -290,7 +320,8 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
   const std::array<std::pair<const CameraCalibration*, const cv::Mat*>, 3> cameras = {
       std::make_pair(left_, &left), std::make_pair(right_, &right), std::make_pair(mono_, &mono)};
   std::array<CameraObservation*, 3> observations = {&frame.left, &frame.right, &frame.mono};
-  if (options_.detector_kind == LightDetectorKind::kBlob && options_.guided_search && frame.T_D_B) {
+  if (options_.detector_kind != LightDetectorKind::kContrast && options_.guided_search &&
+      frame.T_D_B) {
     for (int c = 0; c < 3; ++c) {
       const auto [camera, image] = cameras[c];
       if (!camera || image->empty()) continue;
@@ -303,7 +334,7 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
     }
   }
   // 7 (the search): where the estimate puts the lights of the cameras it identified.
-  if (frame.by_estimate && options_.detector_kind == LightDetectorKind::kBlob &&
+  if (frame.by_estimate && options_.detector_kind != LightDetectorKind::kContrast &&
       options_.guided_search) {
     for (int c = 0; c < 3; ++c) {
       const auto [camera, image] = cameras[c];
@@ -414,6 +445,58 @@ BaselineFrame PaperBaselinePipeline::ProcessDetections(
     }
   }
   NoteIdentified(frame);
+  return frame;
+}
+
+BaselineFrame PaperBaselinePipeline::WeakPass(BaselineFrame frame, const cv::Mat& left,
+                                              const cv::Mat& right, const cv::Mat& mono,
+                                              const std::optional<Pose3>& predicted_T_D_B) {
+  bool more = false;
+  auto weak = [&](const CameraCalibration* camera, const cv::Mat& image, int index,
+                  const CameraObservation& first) {
+    std::optional<std::vector<LightDetection>> detections;
+    if (!camera || image.empty()) return detections;
+    detections = weak_detector_.Detect(image, nullptr,
+                                       options_.weak_halo_fraction * colour_learners_[index].threshold());
+    // The strongest few only: hypothesise-and-verify over many weak blobs costs more than the
+    // rest of the frame, and clutter can fit a layout.
+    const size_t most = dock_.lights.size() + 4;
+    if (detections->size() > most) detections->resize(most);
+    more = more || detections->size() > first.detections.size();
+    return detections;
+  };
+  const auto weak_left = weak(left_, left, 0, frame.left);
+  const auto weak_right = weak(right_, right, 1, frame.right);
+  const auto weak_mono = weak(mono_, mono, 2, frame.mono);
+  if (!more) return frame;
+  const auto last_T_D_B = last_T_D_B_;
+  const int64_t last_t_ns = last_t_ns_;
+  const bool track_symmetry_unresolved = track_symmetry_unresolved_;
+  const auto last_identified_t_ns = last_identified_t_ns_;
+  BaselineFrame retry =
+      ProcessDetections(frame.t_ns, weak_left, weak_right, weak_mono, predicted_T_D_B);
+  RansacMatcherOptions view = options_.ransac;
+  view.min_view_elevation_deg =
+      std::max(view.min_view_elevation_deg, options_.weak_min_view_elevation_deg);
+  const std::array<std::pair<const CameraCalibration*, const CameraObservation*>, 3> cameras = {
+      std::make_pair(left_, &retry.left), std::make_pair(right_, &retry.right),
+      std::make_pair(mono_, &retry.mono)};
+  bool explains_most = retry.T_D_B.has_value();
+  for (const auto& [camera, obs] : cameras) {
+    if (!explains_most) break;
+    if (!camera || obs->status != MatchStatus::kOk) continue;
+    const Pose3 T_C_D = (*retry.T_D_B * camera->T_B_C).Inverse();
+    const size_t in_view =
+        PredictLights(dock_, camera->intrinsics, T_C_D, Eigen::Matrix<double, 6, 6>::Zero(), {})
+            .size();
+    explains_most = CameraAboveTheDeck(dock_, T_C_D, view) &&
+                    obs->num_identified() >= options_.weak_min_support * static_cast<double>(in_view);
+  }
+  if (explains_most) return retry;
+  last_T_D_B_ = last_T_D_B;
+  last_t_ns_ = last_t_ns;
+  track_symmetry_unresolved_ = track_symmetry_unresolved;
+  last_identified_t_ns_ = last_identified_t_ns;
   return frame;
 }
 

@@ -3,7 +3,10 @@
 // and PnP (MonoLightPoser), and the halo colour learned from the identified lights.
 //
 // Per image:
-//   1. Full-image detection (BlobLightDetector) with the learned colour threshold.
+//   1. Full-image detection (BlobLightDetector) with the learned colour threshold, or, with
+//      learned_first_pass, the network learned from renders (learned_light_detector.h; no
+//      rejected candidates to report). Steps 2, 4 and 5 use the blob detector's machinery either
+//      way.
 //   2. With fewer than min_lights detections and a tracked pose from the last frames
 //      (MonoLightPoser::TrackedPose), the dock lights it projects where no detection is are
 //      searched for (GuidedLightSearch) with the motion since then as the gate: each prediction's
@@ -40,6 +43,7 @@
 // Units: pixels, metres; T_C_D maps dock coordinates into the camera frame (OpenCV).
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -49,6 +53,7 @@
 #include "auvdock/vision/blob_light_detector.h"
 #include "auvdock/vision/guided_light_search.h"
 #include "auvdock/vision/halo_colour_learner.h"
+#include "auvdock/vision/learned_light_detector.h"
 #include "auvdock/vision/mono_light_poser.h"
 #include "auvdock/vision/pose_verdict.h"
 
@@ -56,6 +61,8 @@ namespace auvdock {
 
 struct MonoLightPipelineOptions {
   BlobLightDetectorOptions detector;
+  bool learned_first_pass = false;
+  LearnedLightDetectorOptions learned;  // learned_first_pass only
   MonoLightPoserOptions poser;
   bool learn_colour = true;  // false: detector.checks.min_halo_excess throughout
   bool guided_search = true;  // steps 2 and 5
@@ -107,6 +114,7 @@ class MonoLightPipeline {
   DockModel dock_;
   MonoLightPipelineOptions options_;
   BlobLightDetector detector_;
+  std::shared_ptr<const LearnedLightDetector> learned_detector_;  // learned_first_pass only
   BlobLightDetector weak_detector_;
   GuidedLightSearch pose_search_;
   GuidedLightSearch tracked_search_;

@@ -42,6 +42,16 @@
 //      Both: the paper's post-hoc weighted average, weights by the number of lights each
 //      camera system sees, w_s = n_s / (n_s + n_m): position averaged, rotation by slerp.
 //      Neither: no pose ("pause the pose estimate").
+//   5b. weak pass (kBlob and kLearned, weak_pass): a frame without a pose is detected once more
+//      with the blob detector at a laxer response and halo colour (weak_min_response,
+//      weak_halo_fraction; its strongest blobs only, 4 more than the dock has lights per image)
+//      and steps 2-5 run again on those detections. Its pose is taken only if every camera it
+//      identified identifies at least weak_min_support of the lights that pose puts in its
+//      image, and sees the deck from weak_min_view_elevation_deg above its plane or more (as
+//      `detect`'s weak pass, mono_light_pipeline.h); otherwise the frame stays as it was. Why:
+//      the far, dim lights of an approach's first seconds (default scenario: the real-water
+//      detector's full pass found 0-4 of the T dock's lights in the first 4 s, the run started
+//      38 frames late);
 //   6. second look (kBlob, guided_search): with the fused pose of step 5, each camera's dock
 //      lights that it projects where no detection is are searched for in that image
 //      (GuidedLightSearch, each prediction's covariance guided_pose_sigma_px^2 I, its size
@@ -70,6 +80,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <random>
 #include <string>
@@ -81,6 +92,7 @@
 #include "auvdock/io/calibration.h"
 #include "auvdock/io/measurements.h"
 #include "auvdock/vision/blob_light_detector.h"
+#include "auvdock/vision/learned_light_detector.h"
 #include "auvdock/vision/guided_light_search.h"
 #include "auvdock/vision/halo_colour_learner.h"
 #include "auvdock/vision/light_detector.h"
@@ -95,13 +107,16 @@ enum class BaselineMatcher { kRansac, kOmnidirectional };
 
 // kContrast: LightDetector (light_detector.h), developed on our renders; kBlob: the real-water
 // BlobLightDetector (blob_light_detector.h) with a halo colour learned per camera from the
-// identified lights (halo_colour_learner.h).
-enum class LightDetectorKind { kContrast, kBlob };
+// identified lights (halo_colour_learner.h); kLearned: the network learned from randomised renders
+// (learned_light_detector.h; its model file in learned_detector.model_path), with the same
+// learned halo colour, second look and search by the estimate as kBlob.
+enum class LightDetectorKind { kContrast, kBlob, kLearned };
 
 struct PaperBaselineOptions {
   LightDetectorKind detector_kind = LightDetectorKind::kContrast;
   LightDetectorOptions detector;
   BlobLightDetectorOptions blob_detector;
+  LearnedLightDetectorOptions learned_detector;  // kLearned only (its colour: the dock's)
   BaselineMatcher matcher = BaselineMatcher::kRansac;
   RansacMatcherOptions ransac;
   StereoMatchOptions stereo;
@@ -114,7 +129,12 @@ struct PaperBaselineOptions {
   bool use_tracking = true;
   double tracking_max_age_s = 0.5;  // a previous pose older than this predicts nothing
   TrackingMatcherOptions tracking;
-  bool guided_search = true;          // step 6 (kBlob only)
+  bool weak_pass = true;  // step 5b (kBlob and kLearned)
+  double weak_min_response = 12.0;
+  double weak_halo_fraction = 0.3;
+  double weak_min_support = 0.75;
+  double weak_min_view_elevation_deg = 10.0;
+  bool guided_search = true;          // step 6 (kBlob and kLearned)
   GuidedLightSearchOptions guided;
   double guided_pose_sigma_px = 1.5;  // the fused per-frame pose's error at a light, 1 sigma
   bool identify_by_estimate = true;   // step 7
@@ -229,6 +249,10 @@ class PaperBaselinePipeline {
   // blob's size; returns how many stay.
   int WeighEstimateLabels(const CameraCalibration& camera, const Pose3& T_C_D, size_t first,
                           CameraObservation* obs) const;
+  // Step 5b: the frame again from the weak detector's detections; the frame itself when its
+  // pose does not explain most of the lights it puts in view (the tracking state then as before).
+  BaselineFrame WeakPass(BaselineFrame frame, const cv::Mat& left, const cv::Mat& right,
+                         const cv::Mat& mono, const std::optional<Pose3>& predicted_T_D_B);
   // Remembers the frame's time if any camera identified a light in it (step 7's freshness).
   void NoteIdentified(const BaselineFrame& frame);
 
@@ -237,6 +261,8 @@ class PaperBaselinePipeline {
   PaperBaselineOptions options_;
   LightDetector detector_;
   BlobLightDetector blob_detector_;
+  BlobLightDetector weak_detector_;
+  std::shared_ptr<const LearnedLightDetector> learned_detector_;  // kLearned only
   GuidedLightSearch guided_search_;
   std::array<HaloColourLearner, 3> colour_learners_;  // left, right, mono
   std::mt19937_64 rng_;
