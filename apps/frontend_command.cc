@@ -1,5 +1,5 @@
 // auvdock frontend --dataset DIR [--dock FILE] --out OUTDIR [--dehaze] [--no-tracking]
-//                  [--matcher ransac|omnidirectional] [--detector contrast|blob]
+//                  [--matcher ransac|omnidirectional] [--detector blob|learned]
 //
 // Runs the paper's per-frame pipeline (PaperBaselinePipeline) over every camera frame (the next
 // frames' images decoded ahead on a thread of their own, image_prefetcher.h) and writes, flushed
@@ -50,7 +50,7 @@ struct FrontendOptions {
   bool dehaze = false;
   bool no_tracking = false;
   std::string matcher = "ransac";
-  std::string detector = "contrast";
+  std::string detector = "blob";
   std::string detector_model;  // --detector-model; empty: the shipped one
   bool quiet = false;
 };
@@ -62,7 +62,7 @@ void RunFrontend(const FrontendOptions& options) {
   const Dataset dataset = LoadDatasetWithDock(options.dataset, options.dock);
   RequireDock(dataset);
   PaperBaselineOptions pipeline_options;
-  pipeline_options.detector.dehaze = options.dehaze;
+  pipeline_options.dehaze = options.dehaze;
   pipeline_options.use_tracking = !options.no_tracking;
   pipeline_options.detector_kind = ParseDetectorKind(options.detector);
   pipeline_options.learned_detector.model_path =
@@ -200,10 +200,9 @@ void AddFrontendCommand(CLI::App& root) {
   sub->add_option("--matcher", options->matcher, "ransac (default) or omnidirectional")
       ->check(CLI::IsMember({"ransac", "omnidirectional"}));
   sub->add_option("--detector", options->detector,
-                  "contrast (default: developed on our renders), blob (real water: "
-                  "blob_light_detector.h, the dock's colour) or learned (the network learned "
-                  "from randomised renders: learned_light_detector.h)")
-      ->check(CLI::IsMember({"contrast", "blob", "learned"}));
+                  "blob (default: blob_light_detector.h, the dock's colour) or learned (the "
+                  "network learned from randomised renders: learned_light_detector.h)")
+      ->check(CLI::IsMember({"blob", "learned"}));
   sub->add_option("--detector-model", options->detector_model,
                   "The learned detector's ONNX file (default: the shipped " +
                       DefaultLightNetModel() + ")")

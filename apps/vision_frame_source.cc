@@ -81,10 +81,9 @@ bool FileExists(const std::string& path) { return std::filesystem::is_regular_fi
 }  // namespace
 
 LightDetectorKind ParseDetectorKind(const std::string& name) {
-  if (name == "contrast") return LightDetectorKind::kContrast;
   if (name == "blob") return LightDetectorKind::kBlob;
   if (name == "learned") return LightDetectorKind::kLearned;
-  throw InputError("--detector: expected contrast, blob or learned (got '" + name + "')");
+  throw InputError("--detector: expected blob or learned (got '" + name + "')");
 }
 
 std::string DefaultLightNetModel() { return DataPath("models/light_net.onnx"); }
@@ -99,9 +98,9 @@ int64_t SyncToleranceNs(double milliseconds) {
 void AddFrameSourceOptions(CLI::App* sub, FrameSourceOptions* options,
                            const std::string& detections_help) {
   sub->add_option("--detector", options->detector,
-                  "contrast (default: developed on our renders), blob (real water) or learned "
-                  "(the network learned from randomised renders)")
-      ->check(CLI::IsMember({"contrast", "blob", "learned"}));
+                  "blob (default: scale-space blobs, core centroid, shape and colour checks) or "
+                  "learned (the network learned from randomised renders proposes the lights)")
+      ->check(CLI::IsMember({"blob", "learned"}));
   sub->add_option("--detector-model", options->detector_model,
                   "The learned detector's ONNX file (default: the shipped " +
                       DefaultLightNetModel() + ")")

@@ -43,7 +43,7 @@
 
 namespace auvdock::cli {
 
-// "contrast", "blob" or "learned" (the --detector option); throws InputError otherwise.
+// "blob" or "learned" (the --detector option); throws InputError otherwise.
 LightDetectorKind ParseDetectorKind(const std::string& name);
 // The shipped model of the learned detector (data/models/light_net.onnx as the binary finds it).
 std::string DefaultLightNetModel();
@@ -52,7 +52,7 @@ int64_t SyncToleranceNs(double milliseconds);
 
 // The command-line options that choose the frames of `run`, `smooth` and `crlb`.
 struct FrameSourceOptions {
-  std::string detector = "contrast";  // --detector
+  std::string detector = "blob";      // --detector
   double sync_tolerance_ms = -1.0;    // --sync-tolerance-ms; < 0: half the shortest interval
   std::string detections;             // --detections: replay this file instead of the images
   double state_rate_hz = 10.0;        // --state-rate-hz: states without cameras
@@ -71,7 +71,7 @@ class VisionFrameSource {
   // state_rate_hz: the states' rate when the calibration has no camera. detector_model: the
   // learned detector's ONNX file (empty: DefaultLightNetModel()).
   explicit VisionFrameSource(const Dataset& dataset,
-                             LightDetectorKind detector = LightDetectorKind::kContrast,
+                             LightDetectorKind detector = LightDetectorKind::kBlob,
                              int64_t sync_tolerance_ns = -1,
                              const std::string& detections_path = "", double state_rate_hz = 10.0,
                              const std::string& detector_model = "");

@@ -1,8 +1,12 @@
 // Cost of the vision front-end on rendered camera frames of the default scenario (coastal water,
 // reflections, particles and noise on), at the rig's 640 x 512 and at 1280 x 1024:
-//  * BM_Dehaze, BM_Detect: dark-channel dehazing (seed 000's enhancement) and guide-light
-//    detection on the stereo-left frame 8 s into the run (all six lights at about 5 m);
-//  * BM_DetectBlob: the real-water detector (BlobLightDetector) on the same frame;
+//  * BM_Dehaze: dark-channel dehazing (seed 000's enhancement) of the stereo-left frame 8 s into
+//    the run (all six lights at about 5 m);
+//  * BM_DetectBlob: the real-water detector (BlobLightDetector, every command's default) on the
+//    same frame;
+//  * BM_DetectLearned: the learned detector (LearnedLightDetector with the shipped model,
+//    data/models/light_net.onnx: the network at 320 x 256 and the core centroid) on the same
+//    frame;
 //  * BM_DetectBlobFixedLevels: the same without the clip level and the neck cut (for the ratio);
 //  * BM_DetectBlobWithoutSurroundings: the same without the surroundings' colour test;
 //  * BM_OpenCvSimpleBlobDetector: OpenCV's blob detector on the same frame, side by side;
@@ -13,7 +17,7 @@
 //  * BM_PerFrame: the whole per-frame path of the paper's baseline (PaperBaselinePipeline::Process
 //    with dehazing on): dehaze + detect + match (hypothesise-and-verify, MatchRansac) + pose.
 //    Arguments width, height, camera, dehaze (1: on, as the budget counts; 0: the pipeline's
-//    default, see light_detector.h). Camera 0 = the down-looking mono camera at t = 20 s (six
+//    default). Camera 0 = the down-looking mono camera at t = 20 s (six
 //    lights, pose by PnP), 1 = the stereo pair at t = 8 s (six lights in each image; two images
 //    dehazed and detected, the left one matched, the right one labelled by prediction,
 //    triangulation and SVD alignment). Counters: the same steps timed one by one on the same frame
@@ -39,7 +43,7 @@
 #include "auvdock/vision/blob_light_detector.h"
 #include "auvdock/vision/dark_channel_dehazer.h"
 #include "auvdock/vision/image_levels.h"
-#include "auvdock/vision/light_detector.h"
+#include "auvdock/vision/learned_light_detector.h"
 #include "auvdock/vision/paper_baseline_pipeline.h"
 #include "auvdock/vision/saturated_disc.h"
 
@@ -97,10 +101,6 @@ void TimeDetection(const Detector& detector, benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * frame.total());
 }
 
-void BM_Detect(benchmark::State& state) {
-  TimeDetection(LightDetector(), state);  // default options: no dehazing
-}
-BENCHMARK(BM_Detect)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
 
 // The real-water detector (blob_light_detector.h) on the same frame, with the dock's colour.
 void BM_DetectBlob(benchmark::State& state) {
@@ -109,6 +109,14 @@ void BM_DetectBlob(benchmark::State& state) {
   TimeDetection(BlobLightDetector(options), state);
 }
 BENCHMARK(BM_DetectBlob)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
+
+void BM_DetectLearned(benchmark::State& state) {
+  LearnedLightDetectorOptions options;
+  options.model_path = std::string(AUVDOCK_SOURCE_DIR) + "/data/models/light_net.onnx";
+  options.colour = LightColour::kBlueGreen;
+  TimeDetection(LearnedLightDetector(options), state);
+}
+BENCHMARK(BM_DetectLearned)->Args({640, 512})->Args({1280, 1024})->Unit(benchmark::kMillisecond);
 
 void BM_FindSaturatedDiscs(benchmark::State& state) {
   const cv::Mat image =
@@ -234,7 +242,7 @@ void BM_PerFrame(benchmark::State& state) {
   const cv::Mat right = stereo ? RenderFrame(width, height, CameraRole::kStereoRight, t_s) : none;
   const cv::Mat mono = stereo ? none : RenderFrame(width, height, CameraRole::kMono, t_s);
   PaperBaselineOptions options;
-  options.detector.dehaze = state.range(3) == 1;  // the budget counts it; off by default
+  options.dehaze = state.range(3) == 1;  // the budget counts it; off by default
   PaperBaselinePipeline pipeline(calibration, scenario.dock, options);
 
   BaselineFrame frame;
@@ -251,20 +259,25 @@ void BM_PerFrame(benchmark::State& state) {
 
   // The same steps one by one, on one image of the frame (outside the timed loop).
   const cv::Mat& image = stereo ? left : mono;
-  const DarkChannelDehazer dehazer(options.detector.dehaze_options);
-  const LightDetector detector(options.detector);  // dehazes, then detects
+  const DarkChannelDehazer dehazer(options.dehaze_options);
+  BlobLightDetectorOptions blob_options = options.blob_detector;
+  blob_options.checks.colour = ParseLightColour(scenario.dock.light_colour);
+  const BlobLightDetector blob(blob_options);
+  auto detect = [&](const cv::Mat& image) {
+    return blob.Detect(options.dehaze ? dehazer.Dehaze(image).image : image);
+  };
   constexpr int kRepetitions = 20;
-  const double dehaze_ms = !options.detector.dehaze ? 0.0 : MeanMilliseconds(kRepetitions, [&] {
+  const double dehaze_ms = !options.dehaze ? 0.0 : MeanMilliseconds(kRepetitions, [&] {
     benchmark::DoNotOptimize(dehazer.Dehaze(image).image.data);
   });
   const double dehaze_detect_ms = MeanMilliseconds(
-      kRepetitions, [&] { benchmark::DoNotOptimize(detector.Detect(image).data()); });
+      kRepetitions, [&] { benchmark::DoNotOptimize(detect(image).data()); });
   std::optional<std::vector<LightDetection>> left_detections, right_detections, mono_detections;
   if (stereo) {
-    left_detections = detector.Detect(left);
-    right_detections = detector.Detect(right);
+    left_detections = detect(left);
+    right_detections = detect(right);
   } else {
-    mono_detections = detector.Detect(mono);
+    mono_detections = detect(mono);
   }
   const double match_pose_ms = MeanMilliseconds(kRepetitions, [&] {
     benchmark::DoNotOptimize(

@@ -2,7 +2,7 @@
 # Accuracy, covariance consistency (NEES) and go/no-go safety of `auvdock run` (and `smooth`
 # with --smooth) over several seeds of a scenario, on the full image pipeline:
 #   bash scripts/evaluate_seeds.sh [--scenario FILE] [--seeds "1 2 3"] [--out DIR] [--smooth]
-#                                  [--detector contrast|blob] [--reuse-datasets]
+#                                  [--detector blob|learned] [--reuse-datasets]
 #                                  [--config FILE] [--commands "run smooth"]
 # (--reuse-datasets: keep OUT/seed_N/dataset from an earlier call of the same scenario instead of
 # simulating again; --config: estimator options for run and smooth, data/estimator/default.yaml's
@@ -17,7 +17,7 @@ scenario=data/scenarios/default.yaml
 seeds="1 2 3 4 5"
 out=out/seeds
 commands="run"
-detector=contrast
+detector=blob
 reuse=0
 config=()
 while [[ $# -gt 0 ]]; do

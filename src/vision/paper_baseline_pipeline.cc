@@ -50,7 +50,7 @@ PaperBaselinePipeline::PaperBaselinePipeline(const Calibration& calibration, con
     : calibration_(calibration),
       dock_(dock),
       options_(options),
-      detector_(options.detector),
+      dehazer_(options.dehaze_options),
       blob_detector_(WithDockColour(options.blob_detector, dock)),
       weak_detector_(WeakOptions(options, dock)),
       learned_detector_(options.detector_kind == LightDetectorKind::kLearned
@@ -291,37 +291,39 @@ void PaperBaselinePipeline::MonoPose(const std::optional<Pose3>& predicted_T_C_D
   frame->T_D_B_mono = result.T_C_D.Inverse() * mono_->T_B_C.Inverse();
 }
 
-BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
-                                             const cv::Mat& right, const cv::Mat& mono,
+BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left_image,
+                                             const cv::Mat& right_image,
+                                             const cv::Mat& mono_image,
                                              const std::optional<Pose3>& predicted_T_D_B) {
+  // Every step below sees the dehazed images when dehazing is on.
+  auto dehazed = [&](const cv::Mat& image) {
+    return options_.dehaze && !image.empty() ? dehazer_.Dehaze(image).image : image;
+  };
+  const cv::Mat left = dehazed(left_image);
+  const cv::Mat right = dehazed(right_image);
+  const cv::Mat mono = dehazed(mono_image);
   auto detect = [&](const CameraCalibration* camera, const cv::Mat& image, int index) {
     std::optional<std::vector<LightDetection>> detections;
     if (!camera || image.empty()) return detections;
-    if (options_.detector_kind == LightDetectorKind::kBlob) {
-      detections = blob_detector_.Detect(image, nullptr, colour_learners_[index].threshold());
-    } else if (options_.detector_kind == LightDetectorKind::kLearned) {
+    if (options_.detector_kind == LightDetectorKind::kLearned) {
       detections = learned_detector_->Detect(image);
     } else {
-      detections = detector_.Detect(image);
+      detections = blob_detector_.Detect(image, nullptr, colour_learners_[index].threshold());
     }
     return detections;
   };
   BaselineFrame frame = ProcessDetections(t_ns, detect(left_, left, 0), detect(right_, right, 1),
                                           detect(mono_, mono, 2), predicted_T_D_B);
-  if (!frame.T_D_B && options_.weak_pass &&
-      options_.detector_kind != LightDetectorKind::kContrast) {
+  if (!frame.T_D_B && options_.weak_pass) {
     frame = WeakPass(std::move(frame), left, right, mono, predicted_T_D_B);
   }
-  if (options_.detector_kind != LightDetectorKind::kContrast) {
-    colour_learners_[0].Observe(frame.left.detections, frame.left.light_ids);
-    colour_learners_[1].Observe(frame.right.detections, frame.right.light_ids);
-    colour_learners_[2].Observe(frame.mono.detections, frame.mono.light_ids);
-  }
+  colour_learners_[0].Observe(frame.left.detections, frame.left.light_ids);
+  colour_learners_[1].Observe(frame.right.detections, frame.right.light_ids);
+  colour_learners_[2].Observe(frame.mono.detections, frame.mono.light_ids);
   const std::array<std::pair<const CameraCalibration*, const cv::Mat*>, 3> cameras = {
       std::make_pair(left_, &left), std::make_pair(right_, &right), std::make_pair(mono_, &mono)};
   std::array<CameraObservation*, 3> observations = {&frame.left, &frame.right, &frame.mono};
-  if (options_.detector_kind != LightDetectorKind::kContrast && options_.guided_search &&
-      frame.T_D_B) {
+  if (options_.guided_search && frame.T_D_B) {
     for (int c = 0; c < 3; ++c) {
       const auto [camera, image] = cameras[c];
       if (!camera || image->empty()) continue;
@@ -334,8 +336,7 @@ BaselineFrame PaperBaselinePipeline::Process(int64_t t_ns, const cv::Mat& left,
     }
   }
   // 7 (the search): where the estimate puts the lights of the cameras it identified.
-  if (frame.by_estimate && options_.detector_kind != LightDetectorKind::kContrast &&
-      options_.guided_search) {
+  if (frame.by_estimate && options_.guided_search) {
     for (int c = 0; c < 3; ++c) {
       const auto [camera, image] = cameras[c];
       CameraObservation& obs = *observations[c];

@@ -3,7 +3,8 @@
 // initial values.
 //
 // Per frame (three synchronized images: stereo left, stereo right, mono):
-//   1. detect guide lights in every image (LightDetector; optional dark-channel dehazing);
+//   1. detect guide lights in every image (the real-water BlobLightDetector, or the learned
+//      detector; optional dark-channel dehazing first, seed 000);
 //   2. identify them: the left (else right) stereo image and the mono image are matched to the
 //      dock model by hypothesise-and-verify (MatchRansac; the paper's omnidirectional matcher is
 //      selectable), the other stereo image inherits the identities through left-right matching
@@ -42,7 +43,7 @@
 //      Both: the paper's post-hoc weighted average, weights by the number of lights each
 //      camera system sees, w_s = n_s / (n_s + n_m): position averaged, rotation by slerp.
 //      Neither: no pose ("pause the pose estimate").
-//   5b. weak pass (kBlob and kLearned, weak_pass): a frame without a pose is detected once more
+//   5b. weak pass (weak_pass): a frame without a pose is detected once more
 //      with the blob detector at a laxer response and halo colour (weak_min_response,
 //      weak_halo_fraction; its strongest blobs only, 4 more than the dock has lights per image)
 //      and steps 2-5 run again on those detections. Its pose is taken only if every camera it
@@ -52,7 +53,7 @@
 //      the far, dim lights of an approach's first seconds (default scenario: the real-water
 //      detector's full pass found 0-4 of the T dock's lights in the first 4 s, the run started
 //      38 frames late);
-//   6. second look (kBlob, guided_search): with the fused pose of step 5, each camera's dock
+//   6. second look (guided_search): with the fused pose of step 5, each camera's dock
 //      lights that it projects where no detection is are searched for in that image
 //      (GuidedLightSearch, each prediction's covariance guided_pose_sigma_px^2 I, its size
 //      scaled by the identified lights' ObservedSizeRatio) and added
@@ -62,7 +63,7 @@
 //      camera that identified no light labels its detections by the prediction from elsewhere
 //      (the estimator's IMU propagation, predicted_T_D_B) alone (AssociateByPrediction,
 //      prediction_association.h: a unique light within a few pixels; ProcessDetections does
-//      this) and, in Process with kBlob and guided_search, searches where the prediction puts
+//      this) and, in Process with guided_search, searches where the prediction puts
 //      its lights
 //      (estimate_sigma_px; scales up to 4x the expected size, for the large glows of a light
 //      under the camera). Only while the prediction is fresh: some camera identified lights
@@ -95,7 +96,7 @@
 #include "auvdock/vision/learned_light_detector.h"
 #include "auvdock/vision/guided_light_search.h"
 #include "auvdock/vision/halo_colour_learner.h"
-#include "auvdock/vision/light_detector.h"
+#include "auvdock/vision/dark_channel_dehazer.h"
 #include "auvdock/vision/prediction_association.h"
 #include "auvdock/vision/ransac_matcher.h"
 #include "auvdock/vision/stereo_triangulation.h"
@@ -105,16 +106,21 @@ namespace auvdock {
 
 enum class BaselineMatcher { kRansac, kOmnidirectional };
 
-// kContrast: LightDetector (light_detector.h), developed on our renders; kBlob: the real-water
-// BlobLightDetector (blob_light_detector.h) with a halo colour learned per camera from the
-// identified lights (halo_colour_learner.h); kLearned: the network learned from randomised renders
-// (learned_light_detector.h; its model file in learned_detector.model_path), with the same
-// learned halo colour, second look and search by the estimate as kBlob.
-enum class LightDetectorKind { kContrast, kBlob, kLearned };
+// kBlob: the real-water BlobLightDetector (blob_light_detector.h) with a halo colour learned per
+// camera from the identified lights (halo_colour_learner.h); kLearned: the network learned from
+// randomised renders (learned_light_detector.h; its model file in learned_detector.model_path),
+// with the same learned halo colour, weak pass, second look and search by the estimate. (The
+// detector developed on our own renders, light_detector.h, was removed on 2026-12-07: on the real
+// pool clip and on the randomised renders it measured worse than the real-water detector, and it
+// was preferred only on the un-randomised renders it was tuned to; docs/light_detectors.md.)
+enum class LightDetectorKind { kBlob, kLearned };
 
 struct PaperBaselineOptions {
-  LightDetectorKind detector_kind = LightDetectorKind::kContrast;
-  LightDetectorOptions detector;
+  LightDetectorKind detector_kind = LightDetectorKind::kBlob;
+  // Dark-channel dehazing of every image before detection (seed 000). Off by default: it rescales
+  // the lights' contrast and the noise by the same gain (it adds no signal) and makes halos.
+  bool dehaze = false;
+  DehazeOptions dehaze_options;  // seed 000: omega 0.5
   BlobLightDetectorOptions blob_detector;
   LearnedLightDetectorOptions learned_detector;  // kLearned only (its colour: the dock's)
   BaselineMatcher matcher = BaselineMatcher::kRansac;
@@ -129,12 +135,12 @@ struct PaperBaselineOptions {
   bool use_tracking = true;
   double tracking_max_age_s = 0.5;  // a previous pose older than this predicts nothing
   TrackingMatcherOptions tracking;
-  bool weak_pass = true;  // step 5b (kBlob and kLearned)
+  bool weak_pass = true;  // step 5b
   double weak_min_response = 12.0;
   double weak_halo_fraction = 0.3;
   double weak_min_support = 0.75;
   double weak_min_view_elevation_deg = 10.0;
-  bool guided_search = true;          // step 6 (kBlob and kLearned)
+  bool guided_search = true;          // step 6
   GuidedLightSearchOptions guided;
   double guided_pose_sigma_px = 1.5;  // the fused per-frame pose's error at a light, 1 sigma
   bool identify_by_estimate = true;   // step 7
@@ -210,7 +216,7 @@ class PaperBaselinePipeline {
                         const cv::Mat& mono,
                         const std::optional<Pose3>& predicted_T_D_B = std::nullopt);
 
-  // Steps 2-5 on detections made elsewhere (Process = LightDetector::Detect on each image, then
+  // Steps 2-5 on detections made elsewhere (Process = the detector on each image, then
   // this); std::nullopt for an absent camera or image. given: identities reported with them.
   BaselineFrame ProcessDetections(int64_t t_ns,
                                   const std::optional<std::vector<LightDetection>>& left,
@@ -259,7 +265,7 @@ class PaperBaselinePipeline {
   Calibration calibration_;
   DockModel dock_;
   PaperBaselineOptions options_;
-  LightDetector detector_;
+  DarkChannelDehazer dehazer_;
   BlobLightDetector blob_detector_;
   BlobLightDetector weak_detector_;
   std::shared_ptr<const LearnedLightDetector> learned_detector_;  // kLearned only
