@@ -79,7 +79,21 @@ void DrawDockStructures(const DockModel& dock, std::mt19937_64& rng, RenderLook*
     }
   }
   const double clearance = DistanceToNearestLight(dock, best) - 5.0 * light_radius;
-  const double funnel_radius = std::min(0.6, Uniform(rng, 0.6, 0.9) * clearance);
+  double funnel_radius = std::min(0.6, Uniform(rng, 0.6, 0.9) * clearance);
+  // In half of the runs the funnel reaches the lights instead: centred among them, its rim runs
+  // through them (radius 0.85-1.05 of the lights' median distance from their centroid), so that
+  // lights sit against the bright funnel and rim, as on real docks whose lights ring the funnel's
+  // mouth.
+  if (Coin(rng, 0.5) && dock.lights.size() >= 3) {
+    std::vector<double> distances;
+    for (const DockLight& light : dock.lights) {
+      distances.push_back((light.p_D.head<2>() - centre).norm());
+    }
+    std::nth_element(distances.begin(), distances.begin() + distances.size() / 2,
+                     distances.end());
+    best = centre;
+    funnel_radius = std::min(1.0, Uniform(rng, 0.85, 1.05) * distances[distances.size() / 2]);
+  }
   if (funnel_radius > 0.08) {
     DeckFeature funnel;
     funnel.name = "funnel";

@@ -27,7 +27,9 @@
 //                     LED's asymmetric beam gives. The ground truth stays the light's centre.
 //   dock_structures   a white funnel (a bright disc on the deck, 0.9 albedo x 1-2.5 gain after
 //                     the camera's knee, so it can saturate) where the deck is clearest of lights
-//                     (a ring's centre, beside a T's stem), a bright rim
+//                     (a ring's centre, beside a T's stem), or, in half of the runs, centred
+//                     among the lights with its rim through them (0.85-1.05 of their median
+//                     distance from their centroid: lights against a bright funnel), a bright rim
 //                     around it, 1-3 cables (bright or dark strips, 1-3 cm wide), 2-6 specular
 //                     fittings (small saturated white discs at least 15 cm from any light), deck
 //                     albedo 0.3-0.9, lamp power x0.5-2, light housings from black to deck-grey.
