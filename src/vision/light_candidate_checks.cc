@@ -6,6 +6,8 @@
 #include <limits>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
 namespace auvdock {
 namespace {
 
@@ -34,6 +36,42 @@ double SurroundingsExcess(const cv::Mat& bgr, const Eigen::Vector2d& centre, dou
   const size_t k = static_cast<size_t>(quantile * (excess.size() - 1));
   std::nth_element(excess.begin(), excess.begin() + k, excess.end());
   return excess[k];
+}
+
+// tr(H)^2 / det(H) of the Hessian of the luma smoothed at sigma, at the pixel nearest centre;
+// +infinity unless H is negative definite (a blob's maximum).
+double CurvatureRatio(const cv::Mat& luma, const Eigen::Vector2d& centre, double sigma) {
+  const int cx = static_cast<int>(std::lround(centre.x()));
+  const int cy = static_cast<int>(std::lround(centre.y()));
+  const int reach = static_cast<int>(std::ceil(3.0 * sigma)) + 2;
+  const cv::Rect roi = cv::Rect(cx - reach, cy - reach, 2 * reach + 1, 2 * reach + 1) &
+                       cv::Rect(0, 0, luma.cols, luma.rows);
+  if (roi.width < 3 || roi.height < 3 || !roi.contains(cv::Point(cx, cy))) {
+    return std::numeric_limits<double>::infinity();
+  }
+  // At large scales on a patch shrunk by an integer factor to a sigma of ~2 of its pixels (the
+  // ratio of curvatures does not depend on the pixel size): a few hundred pixels per candidate.
+  const int factor = std::max(1, static_cast<int>(sigma / 2.0));
+  cv::Mat patch = luma(roi);
+  if (factor > 1) {
+    cv::resize(patch, patch, cv::Size(std::max(3, roi.width / factor), std::max(3, roi.height / factor)),
+               0, 0, cv::INTER_AREA);
+  }
+  const double s = sigma / factor;
+  cv::Mat smooth;
+  cv::GaussianBlur(patch, smooth, cv::Size(0, 0), s, s, cv::BORDER_REPLICATE);
+  const int x = std::clamp(static_cast<int>(std::lround((cx - roi.x + 0.5) / factor - 0.5)), 1,
+                           smooth.cols - 2);
+  const int y = std::clamp(static_cast<int>(std::lround((cy - roi.y + 0.5) / factor - 0.5)), 1,
+                           smooth.rows - 2);
+  auto at = [&](int dx, int dy) { return static_cast<double>(smooth.at<float>(y + dy, x + dx)); };
+  const double dxx = at(1, 0) - 2.0 * at(0, 0) + at(-1, 0);
+  const double dyy = at(0, 1) - 2.0 * at(0, 0) + at(0, -1);
+  const double dxy = 0.25 * (at(1, 1) - at(1, -1) - at(-1, 1) + at(-1, -1));
+  const double trace = dxx + dyy;
+  const double det = dxx * dyy - dxy * dxy;
+  if (!(det > 0.0) || !(trace < 0.0)) return std::numeric_limits<double>::infinity();
+  return trace * trace / det;
 }
 
 }  // namespace
@@ -132,6 +170,9 @@ LightCandidateEvidence MeasureCandidateEvidence(const cv::Mat& bgr, const cv::Ma
     mid_sum += luma.at<float>(py, px);
     ++mid_count;
   }
+  if (options.max_curvature_ratio > 0.0) {
+    evidence.curvature_ratio = CurvatureRatio(luma, core.uv, sigma_px);
+  }
   if (top_count > 0 && mid_count > 0) {
     const double top = top_sum / top_count - core.floor;
     const double mid = mid_sum / mid_count - core.floor;
@@ -181,6 +222,10 @@ std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore&
   if (!evidence.saturated && candidate.sigma_px >= options.min_flat_sigma_px &&
       evidence.flatness > options.max_flatness) {
     return "flat top (a lit surface)";
+  }
+  const double r = options.max_curvature_ratio;
+  if (r > 0.0 && !(evidence.curvature_ratio <= (r + 1.0) * (r + 1.0) / r)) {
+    return "a ridge (a line or an edge, not a blob)";
   }
   const bool colour_test = has_colour && options.colour != LightColour::kWhite;
   if (colour_test && options.surroundings_halo_radii > 0.0 && evidence.halo_excess > 0.0 &&

@@ -2,7 +2,11 @@
 // measurements themselves are exercised on drawn images in blob_light_detector_test.cc.
 #include "auvdock/vision/light_candidate_checks.h"
 
+#include <cmath>
+#include <limits>
+
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 namespace auvdock {
 namespace {
@@ -56,6 +60,55 @@ TEST(CheckLightCandidate, ASmallCoreMustStandAboveEverySectorOfItsRing) {
   LightCandidateCheckOptions off;
   off.small_core_sigmas = 0.0;
   EXPECT_EQ(Check(SaturatedCore(13.4, 1.1, 10.0), off), "");
+}
+
+// Lowe's edge test with r = 10: a ratio of the principal curvatures above 10, i.e.
+// tr^2 / det above 12.1, or a Hessian that is not negative definite, is a ridge.
+TEST(CheckLightCandidate, ARidgeIsNotABlob) {
+  Candidate c = SaturatedCore(4.0, 3.0, 90.0);
+  c.evidence.curvature_ratio = 4.0;  // a round blob
+  EXPECT_EQ(Check(c), "");
+  c.evidence.curvature_ratio = 12.0;
+  EXPECT_EQ(Check(c), "");
+  c.evidence.curvature_ratio = 12.2;
+  EXPECT_EQ(Check(c).rfind("a ridge", 0), 0u) << Check(c);
+  c.evidence.curvature_ratio = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(Check(c).rfind("a ridge", 0), 0u) << Check(c);
+  LightCandidateCheckOptions off;
+  off.max_curvature_ratio = 0.0;
+  EXPECT_EQ(Check(c, off), "");
+}
+
+// The measured ratio on drawn luma: a round Gaussian blob ~4 (equal curvatures), a 2:1 elliptic
+// one (an interlaced or smeared light) well inside the limit, a bright line (a cable) and a line
+// with a bump on it a ridge.
+TEST(MeasureCandidateEvidence, CurvatureRatioTellsBlobsFromRidges) {
+  auto image = [](double sx, double sy, bool line) {
+    cv::Mat luma(101, 101, CV_32F, cv::Scalar(40.0f));
+    for (int y = 0; y < luma.rows; ++y) {
+      for (int x = 0; x < luma.cols; ++x) {
+        const double dx = x - 50.0, dy = y - 50.0;
+        const double v =
+            line ? 100.0 * std::exp(-0.5 * dy * dy / 4.0) +
+                       15.0 * std::exp(-0.5 * (dx * dx + dy * dy) / 4.0)
+                 : 120.0 * std::exp(-0.5 * (dx * dx / (sx * sx) + dy * dy / (sy * sy)));
+        luma.at<float>(y, x) += static_cast<float>(v);
+      }
+    }
+    return luma;
+  };
+  auto ratio = [](const cv::Mat& luma, double sigma) {
+    LightCore core;
+    core.uv = Eigen::Vector2d(50.0, 50.0);
+    core.peak = luma.at<float>(50, 50);
+    core.floor = 40.0;
+    core.radius_px = 2.0;
+    return MeasureCandidateEvidence(luma, luma, core, sigma, 0.0, {}).curvature_ratio;
+  };
+  EXPECT_NEAR(ratio(image(3.0, 3.0, false), 3.0), 4.0, 0.2);
+  EXPECT_LT(ratio(image(6.0, 3.0, false), 3.0), 7.0);
+  EXPECT_NEAR(ratio(image(30.0, 30.0, false), 30.0), 4.0, 0.3);  // on the shrunk patch
+  EXPECT_GT(ratio(image(1.0, 1.0, true), 2.0), 12.1);
 }
 
 }  // namespace

@@ -31,6 +31,12 @@
 //                  cores only (saturated: a colour channel reaches saturation_level within
 //                  sigma / 2), and for sigma >= min_flat_sigma_px (smaller blobs are shaped by
 //                  the optics, whatever emits them).
+//   curvature_ratio = tr(H)^2 / det(H) of the Hessian H of the luma smoothed at the blob's scale
+//                  sigma, at the pixel nearest c (Lowe 2004, "Distinctive image features from
+//                  scale-invariant keypoints", IJCV 60(2), section 4.1): a blob curves down in
+//                  every direction (both eigenvalues negative and alike: the ratio near 4), a
+//                  ridge (a cable, a lit edge, a rim, a strut) along one only (det <= 0 or the
+//                  ratio large); +infinity when det(H) <= 0 or H is not negative definite.
 // Units: pixels and gray levels.
 #pragma once
 
@@ -100,6 +106,9 @@ struct LightCandidateCheckOptions {
   double max_core_elongation = 3.5;
   double max_core_stretch_px = 45.0;
   double min_flat_sigma_px = 3.0;
+  // A ridge, not a blob: curvature_ratio above (r + 1)^2 / r with r = max_curvature_ratio (the
+  // ratio of the two principal curvatures; Lowe's edge test uses 10). 0: no test.
+  double max_curvature_ratio = 10.0;
   double saturation_level = 250.0;  // gray levels, any channel
 };
 
@@ -110,6 +119,7 @@ struct LightCandidateEvidence {
   double open_drop = 0.0;  // core peak - the open_sectors-th dimmest sector's mean luma
   bool at_border = false;
   double flatness = 0.0;
+  double curvature_ratio = 0.0;  // tr(H)^2 / det(H), +infinity for a ridge or a saddle
   bool saturated = false;
 };
 
@@ -127,7 +137,7 @@ double MedianColourExcess(const cv::Mat& bgr, LightColour colour);
 // border" (the core itself reaches the image's edge: its centre is biased by an unknown amount
 // and the light may be mostly outside), "not a peak" (also "... (a small bump on a larger
 // structure)"), "flat top", "the colour of its
-// surroundings", "wrong colour").
+// surroundings", "wrong colour", "a ridge").
 std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore& core,
                                 const LightCandidateEvidence& evidence, bool has_colour,
                                 const LightCandidateCheckOptions& options);
