@@ -44,11 +44,11 @@ double CurvatureRatio(const cv::Mat& luma, const Eigen::Vector2d& centre, double
   const int cx = static_cast<int>(std::lround(centre.x()));
   const int cy = static_cast<int>(std::lround(centre.y()));
   const int reach = static_cast<int>(std::ceil(3.0 * sigma)) + 2;
-  const cv::Rect roi = cv::Rect(cx - reach, cy - reach, 2 * reach + 1, 2 * reach + 1) &
-                       cv::Rect(0, 0, luma.cols, luma.rows);
-  if (roi.width < 3 || roi.height < 3 || !roi.contains(cv::Point(cx, cy))) {
-    return std::numeric_limits<double>::infinity();
-  }
+  const cv::Rect window(cx - reach, cy - reach, 2 * reach + 1, 2 * reach + 1);
+  const cv::Rect roi = window & cv::Rect(0, 0, luma.cols, luma.rows);
+  // A blob cut by the image's edge is half a blob: its curvature across the edge is unknown (0:
+  // not measured; the border's own checks judge it).
+  if (roi != window) return 0.0;
   // At large scales on a patch shrunk by an integer factor to a sigma of ~2 of its pixels (the
   // ratio of curvatures does not depend on the pixel size): a few hundred pixels per candidate.
   const int factor = std::max(1, static_cast<int>(sigma / 2.0));

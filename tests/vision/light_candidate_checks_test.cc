@@ -84,10 +84,10 @@ TEST(CheckLightCandidate, ARidgeIsNotABlob) {
 // with a bump on it a ridge.
 TEST(MeasureCandidateEvidence, CurvatureRatioTellsBlobsFromRidges) {
   auto image = [](double sx, double sy, bool line) {
-    cv::Mat luma(101, 101, CV_32F, cv::Scalar(40.0f));
+    cv::Mat luma(241, 241, CV_32F, cv::Scalar(40.0f));
     for (int y = 0; y < luma.rows; ++y) {
       for (int x = 0; x < luma.cols; ++x) {
-        const double dx = x - 50.0, dy = y - 50.0;
+        const double dx = x - 120.0, dy = y - 120.0;
         const double v =
             line ? 100.0 * std::exp(-0.5 * dy * dy / 4.0) +
                        15.0 * std::exp(-0.5 * (dx * dx + dy * dy) / 4.0)
@@ -99,8 +99,8 @@ TEST(MeasureCandidateEvidence, CurvatureRatioTellsBlobsFromRidges) {
   };
   auto ratio = [](const cv::Mat& luma, double sigma) {
     LightCore core;
-    core.uv = Eigen::Vector2d(50.0, 50.0);
-    core.peak = luma.at<float>(50, 50);
+    core.uv = Eigen::Vector2d(120.0, 120.0);
+    core.peak = luma.at<float>(120, 120);
     core.floor = 40.0;
     core.radius_px = 2.0;
     return MeasureCandidateEvidence(luma, luma, core, sigma, 0.0, {}).curvature_ratio;
@@ -109,6 +109,8 @@ TEST(MeasureCandidateEvidence, CurvatureRatioTellsBlobsFromRidges) {
   EXPECT_LT(ratio(image(6.0, 3.0, false), 3.0), 7.0);
   EXPECT_NEAR(ratio(image(30.0, 30.0, false), 30.0), 4.0, 0.3);  // on the shrunk patch
   EXPECT_GT(ratio(image(1.0, 1.0, true), 2.0), 12.1);
+  // Cut by the image's edge (the 3 sigma window leaves it): not measured.
+  EXPECT_EQ(ratio(image(3.0, 3.0, false)(cv::Rect(0, 0, 125, 241)).clone(), 3.0), 0.0);
 }
 
 }  // namespace

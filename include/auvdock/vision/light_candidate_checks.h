@@ -36,7 +36,8 @@
 //                  scale-invariant keypoints", IJCV 60(2), section 4.1): a blob curves down in
 //                  every direction (both eigenvalues negative and alike: the ratio near 4), a
 //                  ridge (a cable, a lit edge, a rim, a strut) along one only (det <= 0 or the
-//                  ratio large); +infinity when det(H) <= 0 or H is not negative definite.
+//                  ratio large); +infinity when det(H) <= 0 or H is not negative definite; 0
+//                  (not measured) when the smoothing window (3 sigma) leaves the image.
 // Units: pixels and gray levels.
 #pragma once
 
