@@ -9,7 +9,6 @@
 
 #include "auvdock/vision/field_deinterlace.h"
 #include "auvdock/vision/image_levels.h"
-#include "auvdock/vision/light_candidate_checks.h"
 
 namespace auvdock {
 
@@ -53,6 +52,28 @@ bool LocalMaximum(const cv::Mat& p, int i, int j) {
 }
 
 }  // namespace
+
+std::string VerifyLightProposal(const LightCore& core, const LightCandidateEvidence& evidence,
+                                double noise_sigma, bool has_colour,
+                                const LearnedLightDetectorOptions& options) {
+  const double contrast = core.peak - core.floor;
+  if (contrast < std::max(options.min_contrast, options.min_contrast_noise_sigmas * noise_sigma)) {
+    return "no contrast";
+  }
+  const double r = options.checks.max_curvature_ratio;
+  if (r > 0.0 && !(evidence.curvature_ratio <= (r + 1.0) * (r + 1.0) / r)) {
+    return "a ridge (a line or an edge, not a blob)";
+  }
+  const LightCandidateCheckOptions& c = options.checks;
+  if (!has_colour || options.colour == LightColour::kWhite) return {};
+  if (c.surroundings_halo_radii > 0.0 && evidence.halo_excess > 0.0 &&
+      evidence.halo_excess - evidence.surroundings_excess <
+          c.min_own_colour_fraction * evidence.halo_excess) {
+    return "the colour of its surroundings";
+  }
+  if (evidence.halo_excess < c.min_halo_excess) return "wrong colour";
+  return {};
+}
 
 LearnedLightDetector::LearnedLightDetector(const LearnedLightDetectorOptions& options)
     : options_(options), net_(std::make_unique<Network>()) {
@@ -155,8 +176,8 @@ std::vector<LightDetection> LearnedLightDetector::Detect(const cv::Mat& image) c
   const double noise = EstimatePixelNoise(luma);
   const bool has_colour = source.channels() == 3 && options_.colour != LightColour::kWhite;
   const double background_excess = has_colour ? MedianColourExcess(source, options_.colour) : 0.0;
-  LightCandidateCheckOptions colour_options;
-  colour_options.colour = options_.colour;
+  LightCandidateCheckOptions checks = options_.checks;
+  checks.colour = options_.colour;
 
   std::vector<LightDetection> out;
   for (const Proposal& proposal : proposals) {
@@ -169,23 +190,35 @@ std::vector<LightDetection> LearnedLightDetector::Detect(const cv::Mat& image) c
     const auto core = MeasureLightCore(luma, x, y, proposal.sigma, noise, options_.core);
     const double reach =
         std::max(options_.refine_radius_sigmas * proposal.sigma, options_.min_refine_radius_px);
-    if (core && !core->touches_window && (core->uv - proposed).norm() <= reach) {
-      d.uv = core->uv;
+    const bool refined = core && !core->touches_window && (core->uv - proposed).norm() <= reach;
+    // The core the checks measure: the refined one, or a disc of radius sigma at the proposal
+    // (its floor and peak from the core's window when there is one).
+    LightCore measured;
+    if (refined) {
+      measured = *core;
+    } else {
+      measured.uv = proposed;
+      measured.radius_px = proposal.sigma;
+      measured.peak = core ? core->peak : luma.at<float>(y, x);
+      measured.floor = core ? core->floor : measured.peak;
+    }
+    const LightCandidateEvidence evidence = MeasureCandidateEvidence(
+        source, luma, measured, proposal.sigma, background_excess, checks);
+    if (options_.verify &&
+        !VerifyLightProposal(measured, evidence, noise, has_colour, options_).empty()) {
+      continue;
+    }
+    d.uv = measured.uv;
+    d.peak = measured.peak;
+    d.colour_excess = has_colour ? evidence.halo_excess : 0.0;
+    if (refined) {
       d.covariance = core->covariance;
       d.radius_px = std::max(core->radius_px, proposal.sigma);
-      d.peak = core->peak;
-      if (has_colour) {
-        d.colour_excess = MeasureCandidateEvidence(source, luma, *core, proposal.sigma,
-                                                   background_excess, colour_options)
-                              .halo_excess;
-      }
     } else {
       const double s =
           std::max(options_.proposal_sigma_fraction * proposal.sigma, options_.proposal_floor_px);
-      d.uv = proposed;
       d.covariance = s * s * Eigen::Matrix2d::Identity();
       d.radius_px = proposal.sigma;
-      d.peak = luma.at<float>(y, x);
     }
     const double halo = 2.0 * proposal.sigma;
     d.at_border = d.uv.x() - halo < -0.5 || d.uv.y() - halo < -0.5 ||

@@ -21,7 +21,8 @@
 // uses (light_core_centroid.h: the core above 85 % of the local contrast, its weighted centroid
 // and that centroid's covariance), when the core lies within max(refine_radius_sigmas sigma,
 // min_refine_radius_px) of the proposal and does not run into a larger bright structure
-// (touches_window); otherwise the proposal's own position stands, with a covariance of
+// (touches_window); otherwise the proposal's own position stands (its core then taken as a disc
+// of radius sigma there, for the checks below), with a covariance of
 // (proposal_sigma_fraction sigma)^2, at least proposal_floor_px^2, per axis: the network's
 // position is good to a fraction of the light's size, not to the core's tenths of a pixel. A
 // detection whose halo (2 sigma) leaves the image is at_border, its covariance widened by
@@ -29,6 +30,15 @@
 // heatmap's probability; colour_excess the halo's colour against the image's median
 // (light_candidate_checks.h), for the halo-colour learner. Proposals closer than
 // max(min_separation_px, the larger radius) to a stronger one are the same light.
+//
+// Verification (verify, on by default): the network judges a proposal by what renders taught it,
+// and a textured wall or a lit strut it never saw can look like a light to it. So each proposal
+// must also pass the physical checks of the real-water detector that do not depend on its shape
+// (light_candidate_checks.h, with checks' options): a core with contrast (peak - floor at least
+// min_contrast_noise_sigmas x the image's pixel noise and min_contrast gray levels), not a
+// ridge, a halo of the light's colour (checks.min_halo_excess) that is not just the colour of its
+// surroundings. The shape checks (extent, elongation, flat top, peak drop) are the network's:
+// they are what fails for a light pressed against a white funnel.
 //
 // Units: pixels (0, 0 the centre of the top-left pixel), gray levels. Detect() is const and
 // thread-safe (the network's forward pass is serialised: OpenCV's Net is not re-entrant).
@@ -41,6 +51,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "auvdock/vision/light_candidate_checks.h"
 #include "auvdock/vision/light_colour.h"
 #include "auvdock/vision/light_core_centroid.h"
 #include "auvdock/vision/light_detection.h"
@@ -60,7 +71,16 @@ struct LearnedLightDetectorOptions {
   double border_sigma_fraction = 0.5;
   double min_separation_px = 3.0;
   int max_detections = 64;
+  bool verify = true;
+  LightCandidateCheckOptions checks;  // its colour is set from `colour`
+  double min_contrast = 20.0;
+  double min_contrast_noise_sigmas = 5.0;
 };
+
+// Why a proposal was not kept ("" when it passes): the verification above.
+std::string VerifyLightProposal(const LightCore& core, const LightCandidateEvidence& evidence,
+                                double noise_sigma, bool has_colour,
+                                const LearnedLightDetectorOptions& options);
 
 class LearnedLightDetector {
  public:
