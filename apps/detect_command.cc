@@ -627,10 +627,7 @@ void AddDetectCommand(CLI::App& root) {
                   "blob (default: scale-space blobs and checks) or learned (the network learned "
                   "from randomised renders proposes the lights: learned_light_detector.h)")
       ->check(CLI::IsMember({"blob", "learned"}));
-  sub->add_option("--detector-model", options->detector_model,
-                  "The learned detector's ONNX file (default: the shipped " +
-                      DefaultLightNetModel() + ")")
-      ->check(CLI::ExistingFile);
+  AddDetectorModelOption(sub, &options->detector_model);
   sub->add_flag("--no-tracking", options->no_tracking, "Identify every image from scratch (and no --bridge)");
   sub->add_flag("--keep-unexplained", options->keep_unexplained,
                 "Report as detections what an image's pose leaves unidentified far from every "

@@ -203,10 +203,7 @@ void AddFrontendCommand(CLI::App& root) {
                   "blob (default: blob_light_detector.h, the dock's colour) or learned (the "
                   "network learned from randomised renders: learned_light_detector.h)")
       ->check(CLI::IsMember({"blob", "learned"}));
-  sub->add_option("--detector-model", options->detector_model,
-                  "The learned detector's ONNX file (default: the shipped " +
-                      DefaultLightNetModel() + ")")
-      ->check(CLI::ExistingFile);
+  AddDetectorModelOption(sub, &options->detector_model);
   sub->add_flag("--quiet", options->quiet, "No progress display");
   sub->callback([options] { RunFrontend(*options); });
 }

@@ -88,6 +88,13 @@ LightDetectorKind ParseDetectorKind(const std::string& name) {
 
 std::string DefaultLightNetModel() { return DataPath("models/light_net.onnx"); }
 
+void AddDetectorModelOption(CLI::App* sub, std::string* model) {
+  sub->add_option("--detector-model", *model,
+                  "The learned detector's ONNX file (default: the shipped " +
+                      DefaultLightNetModel() + ")")
+      ->check(CLI::ExistingFile);
+}
+
 int64_t SyncToleranceNs(double milliseconds) {
   if (!std::isfinite(milliseconds) || milliseconds > 1e6) {
     throw InputError("--sync-tolerance-ms: expected a finite number of milliseconds");
@@ -101,10 +108,7 @@ void AddFrameSourceOptions(CLI::App* sub, FrameSourceOptions* options,
                   "blob (default: scale-space blobs, core centroid, shape and colour checks) or "
                   "learned (the network learned from randomised renders proposes the lights)")
       ->check(CLI::IsMember({"blob", "learned"}));
-  sub->add_option("--detector-model", options->detector_model,
-                  "The learned detector's ONNX file (default: the shipped " +
-                      DefaultLightNetModel() + ")")
-      ->check(CLI::ExistingFile);
+  AddDetectorModelOption(sub, &options->detector_model);
   sub->add_option("--sync-tolerance-ms", options->sync_tolerance_ms,
                   "Images of different cameras this close in time share one state (default: half "
                   "the shortest frame interval; 0: equal time stamps only)")

@@ -47,6 +47,8 @@ namespace auvdock::cli {
 LightDetectorKind ParseDetectorKind(const std::string& name);
 // The shipped model of the learned detector (data/models/light_net.onnx as the binary finds it).
 std::string DefaultLightNetModel();
+// Registers --detector-model (the learned detector's ONNX file; empty: DefaultLightNetModel()).
+void AddDetectorModelOption(CLI::App* sub, std::string* model);
 // The --sync-tolerance-ms option in ns: < 0 (the default) stays < 0; NaN/Inf throw InputError.
 int64_t SyncToleranceNs(double milliseconds);
 

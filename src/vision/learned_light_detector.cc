@@ -60,19 +60,9 @@ std::string VerifyLightProposal(const LightCore& core, const LightCandidateEvide
   if (contrast < std::max(options.min_contrast, options.min_contrast_noise_sigmas * noise_sigma)) {
     return "no contrast";
   }
-  const double r = options.checks.max_curvature_ratio;
-  if (r > 0.0 && !(evidence.curvature_ratio <= (r + 1.0) * (r + 1.0) / r)) {
-    return "a ridge (a line or an edge, not a blob)";
-  }
-  const LightCandidateCheckOptions& c = options.checks;
-  if (!has_colour || options.colour == LightColour::kWhite) return {};
-  if (c.surroundings_halo_radii > 0.0 && evidence.halo_excess > 0.0 &&
-      evidence.halo_excess - evidence.surroundings_excess <
-          c.min_own_colour_fraction * evidence.halo_excess) {
-    return "the colour of its surroundings";
-  }
-  if (evidence.halo_excess < c.min_halo_excess) return "wrong colour";
-  return {};
+  LightCandidateCheckOptions checks = options.checks;
+  checks.colour = options.colour;
+  return CheckRidgeAndColour(evidence, has_colour, checks);
 }
 
 LearnedLightDetector::LearnedLightDetector(const LearnedLightDetectorOptions& options)

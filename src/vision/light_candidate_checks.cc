@@ -223,6 +223,11 @@ std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore&
       evidence.flatness > options.max_flatness) {
     return "flat top (a lit surface)";
   }
+  return CheckRidgeAndColour(evidence, has_colour, options);
+}
+
+std::string CheckRidgeAndColour(const LightCandidateEvidence& evidence, bool has_colour,
+                                const LightCandidateCheckOptions& options) {
   const double r = options.max_curvature_ratio;
   if (r > 0.0 && !(evidence.curvature_ratio <= (r + 1.0) * (r + 1.0) / r)) {
     return "a ridge (a line or an edge, not a blob)";

@@ -131,11 +131,8 @@ MonoLightFrame MonoLightPipeline::Process(const cv::Mat& image) {
       weak_view.min_view_elevation_deg =
           std::max(weak_view.min_view_elevation_deg, options_.weak_min_view_elevation_deg);
       const auto explains_most = [&](const MonoPoseResult& r) {
-        if (!CameraAboveTheDeck(dock_, *r.T_C_D, weak_view)) return false;
-        const size_t in_view = PredictLights(dock_, camera_.intrinsics, *r.T_C_D,
-                                             Eigen::Matrix<double, 6, 6>::Zero(), {})
-                                   .size();
-        return r.num_lights >= options_.weak_min_support * static_cast<double>(in_view);
+        return ExplainsMostOfItsView(dock_, camera_.intrinsics, *r.T_C_D, r.num_lights,
+                                     options_.weak_min_support, weak_view);
       };
       MonoPoseResult retry = poser_.Retry(weak, explains_most);
       frame.identify_s += Seconds(t3, Clock::now());

@@ -10,6 +10,7 @@
 #include "auvdock/vision/omnidirectional_matcher.h"
 #include "auvdock/vision/pnp_solver.h"
 #include "auvdock/vision/point_set_alignment.h"
+#include "auvdock/vision/pose_verdict.h"
 
 namespace auvdock {
 namespace {
@@ -486,12 +487,9 @@ BaselineFrame PaperBaselinePipeline::WeakPass(BaselineFrame frame, const cv::Mat
   for (const auto& [camera, obs] : cameras) {
     if (!explains_most) break;
     if (!camera || obs->status != MatchStatus::kOk) continue;
-    const Pose3 T_C_D = (*retry.T_D_B * camera->T_B_C).Inverse();
-    const size_t in_view =
-        PredictLights(dock_, camera->intrinsics, T_C_D, Eigen::Matrix<double, 6, 6>::Zero(), {})
-            .size();
-    explains_most = CameraAboveTheDeck(dock_, T_C_D, view) &&
-                    obs->num_identified() >= options_.weak_min_support * static_cast<double>(in_view);
+    explains_most = ExplainsMostOfItsView(dock_, camera->intrinsics,
+                                          (*retry.T_D_B * camera->T_B_C).Inverse(),
+                                          obs->num_identified(), options_.weak_min_support, view);
   }
   if (explains_most) return retry;
   last_T_D_B_ = last_T_D_B;

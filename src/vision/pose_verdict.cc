@@ -49,4 +49,13 @@ std::vector<bool> NoLightOfTheDock(const std::vector<LightDetection>& detections
   return none;
 }
 
+bool ExplainsMostOfItsView(const DockModel& dock, const PinholeRadtanCamera& camera,
+                           const Pose3& T_C_D, int identified, double min_support,
+                           const RansacMatcherOptions& view) {
+  if (!CameraAboveTheDeck(dock, T_C_D, view)) return false;
+  const size_t in_view =
+      PredictLights(dock, camera, T_C_D, Eigen::Matrix<double, 6, 6>::Zero(), {}).size();
+  return identified >= min_support * static_cast<double>(in_view);
+}
+
 }  // namespace auvdock

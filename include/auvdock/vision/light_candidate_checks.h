@@ -143,4 +143,10 @@ std::string CheckLightCandidate(const BlobCandidate& candidate, const LightCore&
                                 const LightCandidateEvidence& evidence, bool has_colour,
                                 const LightCandidateCheckOptions& options);
 
+// The checks of CheckLightCandidate that do not depend on the core's shape, in its order: "a
+// ridge", "the colour of its surroundings", "wrong colour" (empty when the evidence passes). A
+// proposal that something else judged by its shape (the learned detector) is held to these.
+std::string CheckRidgeAndColour(const LightCandidateEvidence& evidence, bool has_colour,
+                                const LightCandidateCheckOptions& options);
+
 }  // namespace auvdock

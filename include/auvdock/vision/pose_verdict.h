@@ -31,6 +31,7 @@
 #include "auvdock/geometry/pose3.h"
 #include "auvdock/vision/guided_light_search.h"
 #include "auvdock/vision/light_detection.h"
+#include "auvdock/vision/ransac_matcher.h"
 
 namespace auvdock {
 
@@ -64,5 +65,13 @@ class PoseVerdict {
 // (ids[i] >= 0) are never.
 std::vector<bool> NoLightOfTheDock(const std::vector<LightDetection>& detections,
                                    const std::vector<int>& ids, const PoseVerdict& verdict);
+
+// A pose from weak blobs is believed only when it explains most of the dock it puts in view:
+// the camera above the deck (CameraAboveTheDeck with view's limits) and at least min_support of
+// the lights it projects into the image identified (clutter can fit a few lights of a layout,
+// rarely most of them). The weak passes of MonoLightPipeline and PaperBaselinePipeline.
+bool ExplainsMostOfItsView(const DockModel& dock, const PinholeRadtanCamera& camera,
+                           const Pose3& T_C_D, int identified, double min_support,
+                           const RansacMatcherOptions& view);
 
 }  // namespace auvdock
