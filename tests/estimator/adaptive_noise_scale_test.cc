@@ -3,6 +3,7 @@
 #include "auvdock/estimator/adaptive_noise_scale.h"
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -43,6 +44,31 @@ TEST(AdaptiveNoiseScale, StaysWithinItsBounds) {
   const AdaptiveNoiseOptions options;
   EXPECT_DOUBLE_EQ(Converge(100.0, options), options.max_factor);
   EXPECT_DOUBLE_EQ(Converge(0.01, options), options.min_factor);
+}
+
+// A sensor whose error is as large as configured but correlated between samples (AR(1),
+// rho 0.8, as a real DVL's over seconds): the difference of consecutive samples has the variance
+// 2 (1 - rho) instead of 2, so a factor from differences says 0.2. The state-free options keep
+// the configured noise; the default ones would believe the sensor 4x more than they should.
+TEST(AdaptiveNoiseScale, DifferencesOfACorrelatedErrorDoNotNarrowTheStateFreeFactor) {
+  const double rho = 0.8;
+  for (const bool state_free : {false, true}) {
+    AdaptiveNoiseScale scale(state_free ? kStateFreeNoiseOptions : AdaptiveNoiseOptions{});
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> unit(0.0, 1.0);
+    double error = unit(rng);
+    for (int k = 0; k < 5000; ++k) {
+      const double next = rho * error + std::sqrt(1.0 - rho * rho) * unit(rng);
+      const double difference = next - error;
+      error = next;
+      scale.Update(difference * difference / (2.0 * scale.factor()), 1.0);
+    }
+    if (state_free) {
+      EXPECT_DOUBLE_EQ(scale.factor(), 1.0);
+    } else {
+      EXPECT_LT(scale.factor(), 0.3);
+    }
+  }
 }
 
 TEST(AdaptiveNoiseScale, OneBadFrameMovesItLittle) {

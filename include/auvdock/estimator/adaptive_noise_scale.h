@@ -37,6 +37,11 @@ struct AdaptiveNoiseOptions {
   double min_redundancy = 20.0;  // degrees of freedom seen before the factor moves from 1
 };
 
+// For a factor estimated from state-free innovations (differences of consecutive samples):
+// never below the configured noise, since such a difference is blind to an error that is
+// correlated between the samples; it can only show a sensor noisier than configured.
+inline constexpr AdaptiveNoiseOptions kStateFreeNoiseOptions{true, 200.0, 1.0};
+
 class AdaptiveNoiseScale {
  public:
   explicit AdaptiveNoiseScale(const AdaptiveNoiseOptions& options = {}) : options_(options) {}

@@ -166,11 +166,16 @@ struct EstimatorOptions {
   // so a DVL much noisier than configured, whose samples first mostly fail the test, raises the
   // factor until they pass. The factor sets the rate test's and the DVL factor's variance (and
   // so the gate's). Needs dvl_rate_test.
-  AdaptiveNoiseOptions adaptive_dvl_noise;
+  // Never below 1 (kStateFreeNoiseOptions): a difference of consecutive samples sees only the
+  // part of the error that changes between them, so it can show that a sensor is noisier than
+  // configured but not that it is better. A real DVL's error is correlated over seconds
+  // (docs/real_navigation_sensors.md): its rate-test innovations said 0.5x the datasheet's
+  // sigma, and the window that believed it was overconfident (NEES 11-14 on the A-KIT data).
+  AdaptiveNoiseOptions adaptive_dvl_noise = kStateFreeNoiseOptions;
   // The same for the pressure depth, from the second difference of consecutive samples
   // (second_difference.h: state-free, chi-square 1 dof), censored at innovation_outlier_gates x
   // depth_gate_chi2. Time constant 100 samples (10 s at 10 Hz): one dof per sample.
-  AdaptiveNoiseOptions adaptive_depth_noise = AdaptiveNoiseOptions{true, 100.0};
+  AdaptiveNoiseOptions adaptive_depth_noise = AdaptiveNoiseOptions{true, 100.0, 1.0};  // never below 1, as the DVL's
   SecondDifferenceOptions depth_innovation;  // a docking AUV's vertical acceleration: 0.1 m/s^2
   // The cutoff of those state-free statistics, in gates: above it a statistic is an outlier,
   // left out of the factor. Clipped at the gate instead, 2 % SBL multipath (0.5-1 m) gave a
@@ -284,7 +289,7 @@ struct EstimatorOptions {
   // at innovation_outlier_gates x sbl_gate_chi2. It scales every range's sigma, in the factor and
   // so in the gate. Time constant 100 statistics (about 15 s at 2 pings a second and 4
   // transducers).
-  AdaptiveNoiseOptions adaptive_sbl_noise = AdaptiveNoiseOptions{true, 100.0};
+  AdaptiveNoiseOptions adaptive_sbl_noise = AdaptiveNoiseOptions{true, 100.0, 1.0};  // never below 1, as the DVL's
   SecondDifferenceOptions sbl_range_innovation = SecondDifferenceOptions{0.03, 2.5};
   // Multiplies the calibration's IMU noise densities and random walks (sigma, not variance).
   // Datasheet values are measured on a bench, at constant temperature, without vibration; on a
