@@ -79,6 +79,10 @@ nlohmann::json MakeRunSummary(const VisionFrameSource& source, const EstimatorSt
                                          {"dvl", stats.dvl_variance_factor},
                                          {"depth", stats.depth_variance_factor},
                                          {"sbl", stats.sbl_variance_factor}};
+  // The sliding window's slow-error floor at the end (px; window_vision_floor_px, raised to
+  // what the residuals show).
+  summary["window_vision_floor_px"] = stats.window_vision_floor_px;
+  summary["window_vision_correlation_time_s"] = stats.window_vision_correlation_time_s;
   summary["resets"] = stats.resets;
   summary["divergences"] = stats.divergences;  // resets for fixes the gate refused (divergence)
   summary["init_refused"] = stats.init_refused;

@@ -109,6 +109,12 @@ RunConfig LoadRunConfig(const std::string& path) {
   e.smoother_vision_correlation_time_s = est.GetNonNegative("smoother_vision_correlation_time_s",
                                                             e.smoother_vision_correlation_time_s);
   e.window_vision_floor_px = est.GetNonNegative("window_vision_floor_px", e.window_vision_floor_px);
+  e.adaptive_vision_floor.enabled =
+      est.GetBool("adaptive_vision_floor", e.adaptive_vision_floor.enabled);
+  e.max_window_vision_floor_px =
+      est.GetNonNegative("max_window_vision_floor_px", e.max_window_vision_floor_px);
+  e.max_window_vision_correlation_time_s = est.GetNonNegative(
+      "max_window_vision_correlation_time_s", e.max_window_vision_correlation_time_s);
   e.window_vision_correlation_time_s = est.GetNonNegative("window_vision_correlation_time_s",
                                                           e.window_vision_correlation_time_s);
 

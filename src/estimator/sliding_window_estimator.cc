@@ -88,8 +88,11 @@ SlidingWindowEstimator::SlidingWindowEstimator(const Calibration& calibration,
       dvl_noise_(options.adaptive_dvl_noise),
       depth_noise_(options.adaptive_depth_noise),
       sbl_noise_(options.adaptive_sbl_noise),
+      slow_vision_error_(options.adaptive_vision_floor),
       usbl_rate_test_(options.usbl_rate_test),
       acoustic_init_(calibration, dock, options.acoustic_init) {
+  stats_.window_vision_floor_px = WindowVisionFloorPx();
+  stats_.window_vision_correlation_time_s = WindowVisionCorrelationTimeS();
   // An outlier's sample is kept out of the noise statistics (second_difference.h).
   SecondDifferenceOptions depth_innovation = options.depth_innovation;
   depth_innovation.outlier_cutoff = options.innovation_outlier_gates * options.depth_gate_chi2;
@@ -900,9 +903,8 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   VisionFactorOptions vision = options_.vision;
   for (const auto& [id, scale] : mono_noise_) vision.mono_variance_factor[id] = scale.factor();
   for (const auto& [id, scale] : stereo_noise_) vision.stereo_variance_factor[id] = scale.factor();
-  vision.correlated_pixel_variance =
-      CorrelatedVisionVariance(options_.window_vision_floor_px,
-                               options_.window_vision_correlation_time_s, frame_interval_s);
+  vision.correlated_pixel_variance = CorrelatedVisionVariance(
+      WindowVisionFloorPx(), WindowVisionCorrelationTimeS(), frame_interval_s);
   state->vision = AddVisionFactors(problem_.get(), frame, rig_, vision,
                                    StateBlocks(state->pose, state->velocity, &imu_,
                                                BiasFromBlock(state->bias)),
@@ -920,6 +922,12 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   }
   state->n_gated = GateVisionResiduals(problem_.get(), options_.mono_gate_chi2,
                                        options_.stereo_gate_chi2, &state->vision, &rejections_);
+  if (window_.size() >= 2 && frame_interval_s > 0.0) {
+    slow_vision_error_.Add(*problem_, window_.front()->vision, window_[window_.size() - 2]->vision,
+                           state->vision, static_cast<int64_t>(1.5e9 * frame_interval_s));
+    stats_.window_vision_floor_px = WindowVisionFloorPx();
+    stats_.window_vision_correlation_time_s = WindowVisionCorrelationTimeS();
+  }
   // One sensor's residuals through its gate, counted (sensor: its calibration, present whenever
   // it has residuals).
   const auto gate = [&](std::vector<SensorResidual>* residuals, double gate_chi2,
@@ -1013,6 +1021,22 @@ bool SlidingWindowEstimator::ResetOnDivergence(int kept_fixes, int gated_fixes, 
   Reset(text);
   init_refusal_ = text;  // this frame's reason for no estimate, until the restart
   return true;
+}
+
+double SlidingWindowEstimator::WindowVisionFloorPx() const {
+  if (!(options_.window_vision_floor_px > 0.0)) return 0.0;  // white errors only
+  return std::max(options_.window_vision_floor_px,
+                  std::min(options_.max_window_vision_floor_px, slow_vision_error_.slow_px()));
+}
+
+double SlidingWindowEstimator::WindowVisionCorrelationTimeS() const {
+  const double configured = options_.window_vision_correlation_time_s;
+  // The configured time until the residuals show a slow error above the configured floor.
+  if (!(slow_vision_error_.slow_px() > options_.window_vision_floor_px)) return configured;
+  const double measured = slow_vision_error_.correlation_time_s();
+  if (!(measured > 0.0)) return configured;
+  return std::clamp(measured, configured,
+                    std::max(configured, options_.max_window_vision_correlation_time_s));
 }
 
 void SlidingWindowEstimator::UpdateNoiseScales(const State& state, const Matrix6d& covariance) {

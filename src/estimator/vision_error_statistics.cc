@@ -2,36 +2,54 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 #include <tuple>
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+
 
 namespace auvdock {
+
+namespace {
+
+struct Sample {
+  int64_t t_ns;
+  Eigen::Vector3d e;  // pixel-equivalent error
+  double sigma;       // its pixel sigma
+  int m;
+};
+using TrackKey = std::tuple<bool, std::string, int>;  // (mono, camera, light)
+
+// The residual's pixel-equivalent error at the problem's current values; false when it cannot
+// be evaluated or is not finite.
+bool EvaluateSample(const ceres::Problem& problem, const VisionResidual& r, Sample* sample) {
+  Eigen::Vector3d whitened = Eigen::Vector3d::Zero();
+  double cost = 0.0;
+  if (!problem.EvaluateResidualBlock(r.id, /*apply_loss_function=*/false, &cost, whitened.data(),
+                                     nullptr)) {
+    return false;
+  }
+  const int m = r.mono ? 2 : 3;
+  const Eigen::Vector3d e = whitened * r.pixel_sigma_px;
+  if (!e.head(m).allFinite() || !(r.pixel_sigma_px > 0.0)) return false;
+  *sample = {r.t_ns, e, r.pixel_sigma_px, m};
+  return true;
+}
+
+}  // namespace
 
 VisionErrorStatistics MeasureVisionErrors(const ceres::Problem& problem,
                                           const std::vector<VisionResidual>& residuals,
                                           int64_t max_gap_ns) {
-  struct Sample {
-    int64_t t_ns;
-    Eigen::Vector3d e;  // pixel-equivalent error
-    double sigma;       // its pixel sigma
-    int m;
-  };
-  using TrackKey = std::tuple<bool, std::string, int>;  // (mono, camera, light)
   std::map<TrackKey, std::vector<Sample>> tracks;
   for (const VisionResidual& r : residuals) {
-    Eigen::Vector3d whitened = Eigen::Vector3d::Zero();
-    double cost = 0.0;
-    if (!problem.EvaluateResidualBlock(r.id, /*apply_loss_function=*/false, &cost,
-                                       whitened.data(), nullptr)) {
-      continue;
+    Sample sample;
+    if (EvaluateSample(problem, r, &sample)) {
+      tracks[{r.mono, r.sensor, r.light_id}].push_back(sample);
     }
-    const int m = r.mono ? 2 : 3;
-    const Eigen::Vector3d e = whitened * r.pixel_sigma_px;
-    if (!e.head(m).allFinite() || !(r.pixel_sigma_px > 0.0)) continue;
-    tracks[{r.mono, r.sensor, r.light_id}].push_back({r.t_ns, e, r.pixel_sigma_px, m});
   }
   // Information-weighted means (weights 1 / sigma^2, 1 / (sigma_t sigma_t+dt)): the precise
   // detections set the figures, not the few large glows whose own sigma already covers them.
@@ -59,6 +77,162 @@ VisionErrorStatistics MeasureVisionErrors(const ceres::Problem& problem,
   stats.slow_px = std::sqrt(std::max(0.0, c1));
   stats.white_px = std::sqrt(std::max(0.0, c0 - std::max(0.0, c1)));
   return stats;
+}
+
+namespace {
+
+// The information-weighted mean lag product of the pairs between two states' residuals (same
+// light, same camera system): sum of e_t . e_t' / (sigma_t sigma_t') over sum of
+// m / (sigma_t sigma_t'), with that weight, the pairs' coordinates and their mean time lag.
+struct LagProducts {
+  double sum = 0.0, weight = 0.0, pairs = 0.0, lag_s = 0.0;
+};
+
+// One state's residuals as pixel-equivalent errors, with the part a change of the state's pose
+// could explain taken out: the whitened residuals r_i with their Jacobians J_i on the first
+// parameter block (the pose, in its tangent space), r_i - J_i dx with dx the least-squares fit
+// of all of them. What another sensor pulls the pose to (a depth offset, a DVL bias) moves every
+// light the way a pose change does and is taken out; an offset of each light's own mostly
+// stays. For offsets independent between the n coordinates, E[|r_perp|^2] = (1 - k / n) of
+// theirs (least squares with k = rank(J) parameters): *kept_share.
+std::map<TrackKey, Sample> ProjectedSamples(const ceres::Problem& problem,
+                                            const std::vector<VisionResidual>& residuals,
+                                            double* kept_share) {
+  struct Row {
+    TrackKey key;
+    Sample sample;
+    Eigen::Matrix<double, 3, Eigen::Dynamic> J;  // whitened, m x k (unused rows zero)
+    Eigen::Vector3d r;                           // whitened residual
+  };
+  std::vector<Row> rows;
+  int k = -1;
+  double coordinates = 0.0;
+  for (const VisionResidual& r : residuals) {
+    std::vector<double*> blocks;
+    problem.GetParameterBlocksForResidualBlock(r.id, &blocks);
+    if (blocks.empty()) continue;
+    const int tangent = problem.ParameterBlockTangentSize(blocks[0]);
+    if (k != -1 && tangent != k) continue;  // not the same state's pose: left out
+    Row row;
+    row.r.setZero();
+    Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor> J_buffer(3, tangent);
+    J_buffer.setZero();
+    std::vector<double*> jacobians(blocks.size(), nullptr);
+    jacobians[0] = J_buffer.data();
+    double cost = 0.0;
+    if (!problem.EvaluateResidualBlock(r.id, /*apply_loss_function=*/false, &cost, row.r.data(),
+                                       jacobians.data())) {
+      continue;
+    }
+    const int m = r.mono ? 2 : 3;
+    const Eigen::Vector3d e = row.r * r.pixel_sigma_px;
+    if (!e.head(m).allFinite() || !(r.pixel_sigma_px > 0.0) || !J_buffer.allFinite()) continue;
+    k = tangent;
+    row.key = {r.mono, r.sensor, r.light_id};
+    row.sample = {r.t_ns, e, r.pixel_sigma_px, m};
+    row.J = J_buffer;
+    rows.push_back(std::move(row));
+    coordinates += m;
+  }
+  std::map<TrackKey, Sample> samples;
+  *kept_share = 1.0;
+  if (rows.empty()) return samples;
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(k, k);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(k);
+  for (const Row& row : rows) {
+    H += row.J.transpose() * row.J;
+    g += row.J.transpose() * row.r;
+  }
+  // A pseudo-inverse: directions the lights do not observe are not fitted.
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(H);
+  const double largest = eigen.eigenvalues().cwiseAbs().maxCoeff();
+  Eigen::VectorXd dx = Eigen::VectorXd::Zero(k);
+  int rank = 0;
+  for (int i = 0; i < k; ++i) {
+    const double lambda = eigen.eigenvalues()(i);
+    if (!(lambda > 1e-9 * largest)) continue;
+    const Eigen::VectorXd v = eigen.eigenvectors().col(i);
+    dx += v * (v.dot(g) / lambda);
+    ++rank;
+  }
+  *kept_share = 1.0 - rank / coordinates;
+  if (!(*kept_share >= 0.25)) return samples;  // too few lights to tell an offset of their own
+  for (Row& row : rows) {
+    const Eigen::Vector3d r_perp = row.r - row.J * dx;
+    row.sample.e = r_perp * row.sample.sigma;
+    samples[row.key] = row.sample;
+  }
+  return samples;
+}
+
+LagProducts PairResiduals(const ceres::Problem& problem, const std::vector<VisionResidual>& earlier,
+                          const std::vector<VisionResidual>& later, int64_t max_gap_ns) {
+  double kept_before = 1.0, kept_share = 1.0;
+  const std::map<TrackKey, Sample> before = ProjectedSamples(problem, earlier, &kept_before);
+  const std::map<TrackKey, Sample> after = ProjectedSamples(problem, later, &kept_share);
+  // Each product divided by the shares the two fits left (their geometric mean), so that it
+  // estimates the offset's variance, not what is left of it.
+  const double share = std::sqrt(kept_before * kept_share);
+  LagProducts out;
+  double lag_sum = 0.0;
+  for (const auto& [key, s] : after) {
+    const auto it = before.find(key);
+    if (it == before.end()) continue;
+    const Sample& p = it->second;
+    if (s.t_ns - p.t_ns > max_gap_ns || s.t_ns <= p.t_ns || s.m != p.m) continue;
+    out.sum += s.e.dot(p.e) / (s.sigma * p.sigma) / share;  // mono: third entry 0
+    out.weight += s.m / (s.sigma * p.sigma);
+    out.pairs += s.m;
+    lag_sum += s.m * static_cast<double>(s.t_ns - p.t_ns) * 1e-9;
+  }
+  if (out.pairs > 0.0) out.lag_s = lag_sum / out.pairs;
+  return out;
+}
+
+}  // namespace
+
+void SlowVisionError::Moments::Blend(const LagProductsView& frame, double time_constant_frames) {
+  if (frame.pairs == 0.0) return;
+  // This frame's weighted mean lag product, blended in by its information against the frames'
+  // mean information (a frame whose one light is a wide glow moves the estimate little), as a
+  // plain mean over the first time_constant_frames frames and an exponential moving average
+  // after.
+  pairs_seen += frame.pairs;
+  frames_seen += 1.0;
+  const double n = std::min(frames_seen, time_constant_frames);
+  mean_weight += (frame.weight - mean_weight) / n;
+  const double alpha = std::min(1.0, frame.weight / mean_weight / n);
+  mean_product += alpha * (frame.sum / frame.weight - mean_product);
+  mean_lag_s += alpha * (frame.lag_s - mean_lag_s);
+}
+
+void SlowVisionError::Add(const ceres::Problem& problem, const std::vector<VisionResidual>& oldest,
+                          const std::vector<VisionResidual>& previous,
+                          const std::vector<VisionResidual>& newest, int64_t max_gap_ns) {
+  if (!options_.enabled || newest.empty()) return;
+  const LagProducts near = PairResiduals(problem, previous, newest, max_gap_ns);
+  near_.Blend({near.sum, near.weight, near.pairs, near.lag_s}, options_.time_constant_frames);
+  if (&oldest != &previous) {
+    const LagProducts far = PairResiduals(problem, oldest, newest, INT64_MAX);
+    far_.Blend({far.sum, far.weight, far.pairs, far.lag_s}, options_.time_constant_frames);
+  }
+}
+
+double SlowVisionError::slow_px() const {
+  if (!options_.enabled || near_.pairs_seen < options_.min_pairs) return 0.0;
+  return std::sqrt(std::max(0.0, near_.mean_product));
+}
+
+double SlowVisionError::correlation_time_s() const {
+  if (!options_.enabled || near_.pairs_seen < options_.min_pairs ||
+      far_.pairs_seen < options_.min_pairs || !(near_.mean_product > 0.0) ||
+      !(far_.mean_lag_s > near_.mean_lag_s)) {
+    return 0.0;
+  }
+  const double ratio = far_.mean_product / near_.mean_product;
+  if (ratio >= 1.0) return std::numeric_limits<double>::infinity();
+  if (!(ratio > 0.0)) return 0.0;
+  return (far_.mean_lag_s - near_.mean_lag_s) / std::log(1.0 / ratio);
 }
 
 }  // namespace auvdock

@@ -20,11 +20,32 @@ TEST(EstimatorConfigTest, ShippedDefaultsEqualTheBuiltInOnes) {
             defaults.smoother_vision_correlation_time_s);
   EXPECT_EQ(config.estimator.window_size, defaults.window_size);
   EXPECT_EQ(config.estimator.adaptive_dvl_noise.enabled, defaults.adaptive_dvl_noise.enabled);
+  EXPECT_EQ(config.estimator.adaptive_vision_floor.enabled,
+            defaults.adaptive_vision_floor.enabled);
+  EXPECT_EQ(config.estimator.max_window_vision_floor_px, defaults.max_window_vision_floor_px);
+  EXPECT_EQ(config.estimator.max_window_vision_correlation_time_s,
+            defaults.max_window_vision_correlation_time_s);
   EXPECT_EQ(config.estimator.acoustic_init.enabled, defaults.acoustic_init.enabled);
   EXPECT_EQ(config.estimator.acoustic_init.min_fixes, defaults.acoustic_init.min_fixes);
   EXPECT_EQ(config.estimator.acoustic_init.max_span_s, defaults.acoustic_init.max_span_s);
   EXPECT_EQ(config.estimator.acoustic_init.max_heading_sigma_rad,
             defaults.acoustic_init.max_heading_sigma_rad);
+}
+
+TEST(EstimatorConfigTest, WindowVisionFloorKeys) {
+  const test::TempDir dir;
+  const std::string path = dir.path() + "/estimator.yaml";
+  {
+    std::ofstream(path) << "estimator:\n  adaptive_vision_floor: false\n"
+                           "  max_window_vision_floor_px: 0.3\n"
+                           "  max_window_vision_correlation_time_s: 10\n";
+  }
+  const RunConfig config = LoadRunConfig(path);
+  EXPECT_FALSE(config.estimator.adaptive_vision_floor.enabled);
+  EXPECT_EQ(config.estimator.max_window_vision_floor_px, 0.3);
+  EXPECT_EQ(config.estimator.max_window_vision_correlation_time_s, 10.0);
+  { std::ofstream(path) << "estimator:\n  adaptive_vision_floor: maybe\n"; }
+  EXPECT_THROW(LoadRunConfig(path), InputError);
 }
 
 TEST(EstimatorConfigTest, AcousticStartKeys) {

@@ -1,6 +1,7 @@
 #include "auvdock/estimator/vision_error_statistics.h"
 
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <random>
 #include <vector>
@@ -112,6 +113,87 @@ TEST(VisionErrorStatistics, FramesFartherApartThanTheGapAreNotPairedAndNothingGi
   const VisionErrorStatistics empty = MeasureVisionErrors(none.problem, {}, kFrameNs);
   EXPECT_EQ(empty.lag_pairs, 0);
   EXPECT_EQ(empty.white_px, 0.0);
+}
+
+// SlowVisionError, online: frame after frame, the residuals of two consecutive states. Each
+// frame k's mono lights (their pixel errors and sigmas, light i in position i) come from
+// `frame(k)`; returns the estimate after the last frame.
+struct MonoLight {
+  Eigen::Vector2d error_px;
+  double sigma_px;
+};
+double FeedOnline(int frames, const std::function<std::vector<MonoLight>(int)>& frame,
+                  const SlowVisionErrorOptions& options = {}) {
+  Tracks tracks;
+  SlowVisionError slow(options);
+  std::vector<VisionResidual> previous;
+  for (int k = 0; k < frames; ++k) {
+    const size_t first = tracks.residuals.size();
+    const std::vector<MonoLight> lights = frame(k);
+    for (size_t i = 0; i < lights.size(); ++i) {
+      tracks.AddMono(static_cast<int>(i), {lights[i].error_px}, lights[i].sigma_px);
+      tracks.residuals.back().t_ns = k * kFrameNs;
+    }
+    std::vector<VisionResidual> newest(tracks.residuals.begin() + first, tracks.residuals.end());
+    slow.Add(tracks.problem, previous, previous, newest, 3 * kFrameNs / 2);
+    previous = newest;
+  }
+  return slow.slow_px();
+}
+
+// Eight lights, each with its own constant bias (as a light's asymmetric lobe gives, 1-sigma
+// bias_px per coordinate) plus white noise of white_px, whitened with 0.3 px.
+double BiasedLights(int frames, double bias_px, double white_px,
+                    const SlowVisionErrorOptions& options = {}) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> normal;
+  std::vector<Eigen::Vector2d> bias;
+  for (int light = 0; light < 8; ++light) {
+    bias.push_back(bias_px * Eigen::Vector2d(normal(rng), normal(rng)));
+  }
+  return FeedOnline(
+      frames,
+      [&](int) {
+        std::vector<MonoLight> lights;
+        for (const Eigen::Vector2d& b : bias) {
+          const Eigen::Vector2d white(white_px * normal(rng), white_px * normal(rng));
+          lights.push_back({b + white, 0.3});
+        }
+        return lights;
+      },
+      options);
+}
+
+TEST(SlowVisionError, FindsPerLightBiasesOnlineAndNothingInWhiteErrors) {
+  EXPECT_NEAR(BiasedLights(600, 0.2, 0.3), 0.2, 0.05);
+  EXPECT_LT(BiasedLights(600, 0.0, 0.3), 0.04);
+}
+
+TEST(SlowVisionError, WaitsForEnoughPairsAndCanBeOff) {
+  EXPECT_EQ(BiasedLights(5, 0.2, 0.3), 0.0);  // 64 pairs of the 200 needed
+  SlowVisionErrorOptions off;
+  off.enabled = false;
+  EXPECT_EQ(BiasedLights(600, 0.2, 0.3, off), 0.0);
+}
+
+// After a lit approach with white errors, frames whose one light is a wide glow (sigma 5 px)
+// with a persistent 3 px error: their information is a hundredth of the approach's frames', so
+// the floor stays near where the approach put it instead of jumping to the glow's error.
+TEST(SlowVisionError, AWideGlowsPersistentErrorMovesItLittle) {
+  std::mt19937_64 rng(13);
+  std::normal_distribution<double> normal;
+  const double slow = FeedOnline(400, [&](int k) {
+    std::vector<MonoLight> lights;
+    if (k >= 300) {
+      lights.push_back({Eigen::Vector2d(3.0, 0.0), 5.0});
+      return lights;
+    }
+    for (int light = 0; light < 8; ++light) {
+      lights.push_back({Eigen::Vector2d(0.3 * normal(rng), 0.3 * normal(rng)), 0.3});
+    }
+    return lights;
+  });
+  EXPECT_LT(slow, 0.1);
 }
 
 }  // namespace

@@ -1,3 +1,4 @@
+#include <map>
 #include "tests/testing/synthetic_vision.h"
 
 #include <cmath>
@@ -98,6 +99,24 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
     o = noise.correlated_px *
         Eigen::Vector2d(StandardNormal(offset_rng), StandardNormal(offset_rng));
   }
+  // Per-light constant offsets (left, right, mono), by light id.
+  std::mt19937_64 bias_rng = MakeRandomStream(seed, 107);
+  std::map<int, Eigen::Vector2d> light_bias[3];
+  for (std::map<int, Eigen::Vector2d>& camera : light_bias) {
+    for (const DockLight& light : run.dock.lights) {
+      camera[light.id] = noise.light_bias_px *
+                         Eigen::Vector2d(StandardNormal(bias_rng), StandardNormal(bias_rng));
+    }
+  }
+  // A light's offset in one camera where it is seen at uv.
+  const auto bias = [&](int camera, const CameraCalibration& calibration, int light_id,
+                        const Eigen::Vector2d& uv) -> Eigen::Vector2d {
+    const Eigen::Vector2d& b = light_bias[camera][light_id];
+    if (!noise.view_dependent_bias) return b;
+    const PinholeRadtanCamera& k = calibration.intrinsics;
+    const double angle = std::atan2(b.y(), b.x()) + std::atan2(uv.y() - k.cy(), uv.x() - k.cx());
+    return b.norm() * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+  };
   for (int64_t k = 0;; ++k) {
     const int64_t t = simulator.SampleTime(k, rate);
     if (simulator.Seconds(t) > scenario.duration_s) break;
@@ -120,15 +139,18 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
     for (const DockLight& light : run.dock.lights) {
       if (mono) {
         if (const auto uv = See(*mono, T_D_B_mono, light.p_D, pixel_sigma, rng)) {
-          frame.mono.push_back({light.id, *uv + offset[2], pixel_sigma});
+          frame.mono.push_back(
+              {light.id, *uv + offset[2] + bias(2, *mono, light.id, *uv), pixel_sigma});
         }
       }
       if (left && right) {
         const auto uv_left = See(*left, T_D_B, light.p_D, pixel_sigma, rng);
         const auto uv_right = See(*right, T_D_B, light.p_D, pixel_sigma, rng);
         if (uv_left && uv_right) {
-          const TriangulatedPoint p = TriangulateLinear(*uv_left + offset[0], *uv_right + offset[1],
-                                                        *left, *right, pixel_sigma);
+          const TriangulatedPoint p =
+              TriangulateLinear(*uv_left + offset[0] + bias(0, *left, light.id, *uv_left),
+                                *uv_right + offset[1] + bias(1, *right, light.id, *uv_right),
+                                *left, *right, pixel_sigma);
           if (p.ok) frame.stereo.push_back({light.id, p.p_S, p.covariance});
         }
       }

@@ -42,10 +42,16 @@ SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed, double pi
 // a stationary AR(1) process per camera and pixel coordinate with 1-sigma correlated_px and
 // autocorrelation exp(-|t| / correlation_time_s) (drawn from its own random stream, so the
 // white draws are those of the overload above). The cameras' pixel_noise_px is white_px.
+// light_bias_px: in addition, an offset per light and camera (1-sigma per pixel coordinate), as
+// a light's asymmetric lobe gives, drawn from a third stream: constant, or, with
+// view_dependent_bias, turned with the light's direction from the principal point (the offset's
+// angle is its own plus that of (u - c_x, v - c_y)), so that it changes as the view does.
 struct SyntheticPixelNoise {
   double white_px = 0.3;
   double correlated_px = 0.0;
   double correlation_time_s = 1.0;
+  double light_bias_px = 0.0;
+  bool view_dependent_bias = false;
 };
 SyntheticRun MakeSyntheticRun(const Scenario& scenario, uint64_t seed,
                               const SyntheticPixelNoise& noise);

@@ -18,6 +18,7 @@
 //     smoother_vision_correlation_time_s: 2.0
 //     window_vision_floor_px: 0.07     # sliding window: the same model; 0 = white errors only
 //     window_vision_correlation_time_s: 1.0
+//     adaptive_vision_floor: true      # raise it to the slow error the residuals show
 //   go_no_go:
 //     allowed_lateral_error_m: 0.10
 //     max_yaw_3sigma_rad: 0.05

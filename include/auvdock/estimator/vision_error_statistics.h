@@ -24,6 +24,17 @@
 // So the figures are a diagnostic (summary.json `vision_errors`: is pixel_noise_px about
 // right?), not a noise model to adapt to.
 // Units: px. Only finite residuals of tracks with consecutive frames (gap <= max_gap_ns) count.
+//
+// SlowVisionError is the same C1 for the sliding window, online: after each solve it pairs the
+// residuals of the newest state with those of the previous one (the same light in the same
+// camera system, both at the current solution) and keeps an exponential moving average of the
+// information-weighted lag products over time_constant_frames frames. Each product is divided
+// by the share of an offset a pose leaves in the residuals, 1 - 6 / n for a frame of n
+// coordinates (least squares with 6 parameters), so that sqrt(C1) estimates the slow error
+// rather than what is left of it. The window takes it as its floor (window_vision_floor_px)
+// when it is larger than the configured one, so that the allowance for slow errors follows
+// views whose biases nobody configured. Pairs with the oldest state (a lag of the window's
+// span) give the slow part's decay, and so its correlation time.
 #pragma once
 
 #include <cstdint>
@@ -46,5 +57,49 @@ struct VisionErrorStatistics {
 VisionErrorStatistics MeasureVisionErrors(const ceres::Problem& problem,
                                           const std::vector<VisionResidual>& residuals,
                                           int64_t max_gap_ns);
+
+struct SlowVisionErrorOptions {
+  bool enabled = true;
+  double time_constant_frames = 200.0;  // frames with pairs (20 s at 10 Hz), each weighted by
+                                        // its information against the frames' mean
+  double min_pairs = 200.0;             // coordinate pairs seen before slow_px() is other than 0
+};
+
+class SlowVisionError {
+ public:
+  explicit SlowVisionError(const SlowVisionErrorOptions& options = {}) : options_(options) {}
+
+  // The vision residuals of the window's oldest, previous and newest states, still in the
+  // problem: the newest against the previous gives C1 (pairs further apart than max_gap_ns are
+  // not counted), against the oldest C_L, a lag of the window's span; pass `previous` as
+  // `oldest` when the window holds two states.
+  void Add(const ceres::Problem& problem, const std::vector<VisionResidual>& oldest,
+           const std::vector<VisionResidual>& previous, const std::vector<VisionResidual>& newest,
+           int64_t max_gap_ns);
+
+  // sqrt(max(0, C1)) once min_pairs coordinate pairs were seen; 0 before, or when disabled.
+  double slow_px() const;
+  // The slow part's correlation time (s) from the decay between the two lags, C_L / C1 =
+  // exp(-(lag_L - lag_1) / tau): infinite when it does not decay (constant biases), 0 when
+  // nothing is known yet (or C1 <= 0).
+  double correlation_time_s() const;
+  double pairs_seen() const { return near_.pairs_seen; }
+
+ private:
+  struct LagProductsView {
+    double sum, weight, pairs, lag_s;
+  };
+  struct Moments {
+    double mean_product = 0.0;  // EMA of the weighted lag products per weight (px^2)
+    double mean_weight = 0.0;   // EMA of a frame's weight, sum of m / (sigma sigma') (1/px^2)
+    double mean_lag_s = 0.0;    // EMA of the pairs' time lag (s)
+    double pairs_seen = 0.0;
+    double frames_seen = 0.0;
+    void Blend(const LagProductsView& frame, double time_constant_frames);
+  };
+  SlowVisionErrorOptions options_;
+  Moments near_;  // newest against previous
+  Moments far_;   // newest against oldest
+};
 
 }  // namespace auvdock
