@@ -922,9 +922,9 @@ std::optional<EstimatorOutput> SlidingWindowEstimator::AddVisionFrame(const Visi
   }
   state->n_gated = GateVisionResiduals(problem_.get(), options_.mono_gate_chi2,
                                        options_.stereo_gate_chi2, &state->vision, &rejections_);
-  if (window_.size() >= 2 && frame_interval_s > 0.0) {
-    slow_vision_error_.Add(*problem_, window_.front()->vision, window_[window_.size() - 2]->vision,
-                           state->vision, static_cast<int64_t>(1.5e9 * frame_interval_s));
+  if (frame_interval_s > 0.0) {
+    slow_vision_error_.Add(*problem_, state->vision,
+                           static_cast<int64_t>(1.5e9 * frame_interval_s));
     stats_.window_vision_floor_px = WindowVisionFloorPx();
     stats_.window_vision_correlation_time_s = WindowVisionCorrelationTimeS();
   }

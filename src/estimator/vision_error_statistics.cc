@@ -15,13 +15,8 @@ namespace auvdock {
 
 namespace {
 
-struct Sample {
-  int64_t t_ns;
-  Eigen::Vector3d e;  // pixel-equivalent error
-  double sigma;       // its pixel sigma
-  int m;
-};
-using TrackKey = std::tuple<bool, std::string, int>;  // (mono, camera, light)
+using Sample = VisionErrorSample;
+using TrackKey = VisionTrackKey;
 
 // The residual's pixel-equivalent error at the problem's current values; false when it cannot
 // be evaluated or is not finite.
@@ -39,62 +34,14 @@ bool EvaluateSample(const ceres::Problem& problem, const VisionResidual& r, Samp
   return true;
 }
 
-}  // namespace
-
-VisionErrorStatistics MeasureVisionErrors(const ceres::Problem& problem,
-                                          const std::vector<VisionResidual>& residuals,
-                                          int64_t max_gap_ns) {
-  std::map<TrackKey, std::vector<Sample>> tracks;
-  for (const VisionResidual& r : residuals) {
-    Sample sample;
-    if (EvaluateSample(problem, r, &sample)) {
-      tracks[{r.mono, r.sensor, r.light_id}].push_back(sample);
-    }
-  }
-  // Information-weighted means (weights 1 / sigma^2, 1 / (sigma_t sigma_t+dt)): the precise
-  // detections set the figures, not the few large glows whose own sigma already covers them.
-  double sum0 = 0.0, weight0 = 0.0, sum1 = 0.0, weight1 = 0.0;
-  VisionErrorStatistics stats;
-  for (auto& [key, track] : tracks) {
-    std::sort(track.begin(), track.end(),
-              [](const Sample& a, const Sample& b) { return a.t_ns < b.t_ns; });
-    for (size_t k = 0; k < track.size(); ++k) {
-      const Sample& s = track[k];
-      sum0 += s.e.head(s.m).squaredNorm() / (s.sigma * s.sigma);
-      weight0 += s.m / (s.sigma * s.sigma);
-      stats.coordinates += s.m;
-      if (k == 0) continue;
-      const Sample& p = track[k - 1];
-      if (s.t_ns - p.t_ns > max_gap_ns || s.t_ns == p.t_ns) continue;
-      sum1 += s.e.head(s.m).dot(p.e.head(s.m)) / (s.sigma * p.sigma);
-      weight1 += s.m / (s.sigma * p.sigma);
-      stats.lag_pairs += s.m;
-    }
-  }
-  if (stats.lag_pairs == 0) return stats;  // nothing measured: both figures 0
-  const double c0 = sum0 / weight0;
-  const double c1 = sum1 / weight1;
-  stats.slow_px = std::sqrt(std::max(0.0, c1));
-  stats.white_px = std::sqrt(std::max(0.0, c0 - std::max(0.0, c1)));
-  return stats;
-}
-
-namespace {
-
-// The information-weighted mean lag product of the pairs between two states' residuals (same
-// light, same camera system): sum of e_t . e_t' / (sigma_t sigma_t') over sum of
-// m / (sigma_t sigma_t'), with that weight, the pairs' coordinates and their mean time lag.
-struct LagProducts {
-  double sum = 0.0, weight = 0.0, pairs = 0.0, lag_s = 0.0;
-};
-
 // One state's residuals as pixel-equivalent errors, with the part a change of the state's pose
 // could explain taken out: the whitened residuals r_i with their Jacobians J_i on the first
 // parameter block (the pose, in its tangent space), r_i - J_i dx with dx the least-squares fit
 // of all of them. What another sensor pulls the pose to (a depth offset, a DVL bias) moves every
 // light the way a pose change does and is taken out; an offset of each light's own mostly
 // stays. For offsets independent between the n coordinates, E[|r_perp|^2] = (1 - k / n) of
-// theirs (least squares with k = rank(J) parameters): *kept_share.
+// theirs (least squares with k = rank(J) parameters): *kept_share. Empty when the fit leaves
+// less than a quarter (too few lights to tell an offset of their own).
 std::map<TrackKey, Sample> ProjectedSamples(const ceres::Problem& problem,
                                             const std::vector<VisionResidual>& residuals,
                                             double* kept_share) {
@@ -156,7 +103,7 @@ std::map<TrackKey, Sample> ProjectedSamples(const ceres::Problem& problem,
     ++rank;
   }
   *kept_share = 1.0 - rank / coordinates;
-  if (!(*kept_share >= 0.25)) return samples;  // too few lights to tell an offset of their own
+  if (!(*kept_share >= 0.25)) return samples;
   for (Row& row : rows) {
     const Eigen::Vector3d r_perp = row.r - row.J * dx;
     row.sample.e = r_perp * row.sample.sigma;
@@ -165,56 +112,92 @@ std::map<TrackKey, Sample> ProjectedSamples(const ceres::Problem& problem,
   return samples;
 }
 
-LagProducts PairResiduals(const ceres::Problem& problem, const std::vector<VisionResidual>& earlier,
-                          const std::vector<VisionResidual>& later, int64_t max_gap_ns) {
-  double kept_before = 1.0, kept_share = 1.0;
-  const std::map<TrackKey, Sample> before = ProjectedSamples(problem, earlier, &kept_before);
-  const std::map<TrackKey, Sample> after = ProjectedSamples(problem, later, &kept_share);
-  // Each product divided by the shares the two fits left (their geometric mean), so that it
-  // estimates the offset's variance, not what is left of it.
-  const double share = std::sqrt(kept_before * kept_share);
-  LagProducts out;
-  double lag_sum = 0.0;
-  for (const auto& [key, s] : after) {
-    const auto it = before.find(key);
-    if (it == before.end()) continue;
-    const Sample& p = it->second;
-    if (s.t_ns - p.t_ns > max_gap_ns || s.t_ns <= p.t_ns || s.m != p.m) continue;
-    out.sum += s.e.dot(p.e) / (s.sigma * p.sigma) / share;  // mono: third entry 0
-    out.weight += s.m / (s.sigma * p.sigma);
-    out.pairs += s.m;
-    lag_sum += s.m * static_cast<double>(s.t_ns - p.t_ns) * 1e-9;
-  }
-  if (out.pairs > 0.0) out.lag_s = lag_sum / out.pairs;
-  return out;
-}
-
 }  // namespace
 
-void SlowVisionError::Moments::Blend(const LagProductsView& frame, double time_constant_frames) {
-  if (frame.pairs == 0.0) return;
+VisionErrorStatistics MeasureVisionErrors(const ceres::Problem& problem,
+                                          const std::vector<VisionResidual>& residuals,
+                                          int64_t max_gap_ns) {
+  std::map<TrackKey, std::vector<Sample>> tracks;
+  for (const VisionResidual& r : residuals) {
+    Sample sample;
+    if (EvaluateSample(problem, r, &sample)) {
+      tracks[{r.mono, r.sensor, r.light_id}].push_back(sample);
+    }
+  }
+  // Information-weighted means (weights 1 / sigma^2, 1 / (sigma_t sigma_t+dt)): the precise
+  // detections set the figures, not the few large glows whose own sigma already covers them.
+  double sum0 = 0.0, weight0 = 0.0, sum1 = 0.0, weight1 = 0.0;
+  VisionErrorStatistics stats;
+  for (auto& [key, track] : tracks) {
+    std::sort(track.begin(), track.end(),
+              [](const Sample& a, const Sample& b) { return a.t_ns < b.t_ns; });
+    for (size_t k = 0; k < track.size(); ++k) {
+      const Sample& s = track[k];
+      sum0 += s.e.head(s.m).squaredNorm() / (s.sigma * s.sigma);
+      weight0 += s.m / (s.sigma * s.sigma);
+      stats.coordinates += s.m;
+      if (k == 0) continue;
+      const Sample& p = track[k - 1];
+      if (s.t_ns - p.t_ns > max_gap_ns || s.t_ns == p.t_ns) continue;
+      sum1 += s.e.head(s.m).dot(p.e.head(s.m)) / (s.sigma * p.sigma);
+      weight1 += s.m / (s.sigma * p.sigma);
+      stats.lag_pairs += s.m;
+    }
+  }
+  if (stats.lag_pairs == 0) return stats;  // nothing measured: both figures 0
+  const double c0 = sum0 / weight0;
+  const double c1 = sum1 / weight1;
+  stats.slow_px = std::sqrt(std::max(0.0, c1));
+  stats.white_px = std::sqrt(std::max(0.0, c0 - std::max(0.0, c1)));
+  return stats;
+}
+
+void SlowVisionError::Moments::Blend(const FrameSamples& earlier, const FrameSamples& later,
+                                     int64_t max_gap_ns, double time_constant_frames) {
+  // Each product divided by the shares the two fits left (their geometric mean), so that it
+  // estimates the offset's variance, not what is left of it.
+  const double share = std::sqrt(earlier.kept_share * later.kept_share);
+  double sum = 0.0, weight = 0.0, pairs = 0.0, lag_sum = 0.0;
+  for (const auto& [key, s] : later.samples) {
+    const auto it = earlier.samples.find(key);
+    if (it == earlier.samples.end()) continue;
+    const Sample& p = it->second;
+    if (s.t_ns - p.t_ns > max_gap_ns || s.t_ns <= p.t_ns || s.m != p.m) continue;
+    sum += s.e.dot(p.e) / (s.sigma * p.sigma) / share;  // a mono residual's third entry is 0
+    weight += s.m / (s.sigma * p.sigma);
+    pairs += s.m;
+    lag_sum += s.m * static_cast<double>(s.t_ns - p.t_ns) * 1e-9;
+  }
+  if (pairs == 0.0) return;
   // This frame's weighted mean lag product, blended in by its information against the frames'
   // mean information (a frame whose one light is a wide glow moves the estimate little), as a
   // plain mean over the first time_constant_frames frames and an exponential moving average
   // after.
-  pairs_seen += frame.pairs;
+  pairs_seen += pairs;
   frames_seen += 1.0;
   const double n = std::min(frames_seen, time_constant_frames);
-  mean_weight += (frame.weight - mean_weight) / n;
-  const double alpha = std::min(1.0, frame.weight / mean_weight / n);
-  mean_product += alpha * (frame.sum / frame.weight - mean_product);
-  mean_lag_s += alpha * (frame.lag_s - mean_lag_s);
+  mean_weight += (weight - mean_weight) / n;
+  const double alpha = std::min(1.0, weight / mean_weight / n);
+  mean_product += alpha * (sum / weight - mean_product);
+  mean_lag_s += alpha * (lag_sum / pairs - mean_lag_s);
 }
 
-void SlowVisionError::Add(const ceres::Problem& problem, const std::vector<VisionResidual>& oldest,
-                          const std::vector<VisionResidual>& previous,
-                          const std::vector<VisionResidual>& newest, int64_t max_gap_ns) {
-  if (!options_.enabled || newest.empty()) return;
-  const LagProducts near = PairResiduals(problem, previous, newest, max_gap_ns);
-  near_.Blend({near.sum, near.weight, near.pairs, near.lag_s}, options_.time_constant_frames);
-  if (&oldest != &previous) {
-    const LagProducts far = PairResiduals(problem, oldest, newest, INT64_MAX);
-    far_.Blend({far.sum, far.weight, far.pairs, far.lag_s}, options_.time_constant_frames);
+void SlowVisionError::Add(const ceres::Problem& problem, const std::vector<VisionResidual>& newest,
+                          int64_t max_gap_ns) {
+  if (!options_.enabled) return;
+  FrameSamples frame;
+  frame.samples = ProjectedSamples(problem, newest, &frame.kept_share);
+  if (!history_.empty()) {
+    near_.Blend(history_.back(), frame, max_gap_ns, options_.time_constant_frames);
+  }
+  if (static_cast<int>(history_.size()) >= options_.far_lag_frames &&
+      options_.far_lag_frames > 1) {
+    far_.Blend(history_.front(), frame, max_gap_ns * options_.far_lag_frames,
+               options_.time_constant_frames);
+  }
+  history_.push_back(std::move(frame));
+  while (static_cast<int>(history_.size()) > std::max(1, options_.far_lag_frames)) {
+    history_.pop_front();
   }
 }
 

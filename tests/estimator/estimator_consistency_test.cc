@@ -187,8 +187,8 @@ TEST(EstimatorConsistencyTest, SlidingWindowModelsTimeCorrelatedPixelErrors) {
 // white noise, vision and IMU only: at the fixed least floor (0.05 px) the window fuses the same
 // offsets frame after frame and is overconfident (NEES 17.7); with the floor following what the
 // residuals show (adaptive_vision_floor, the default) it is within the bound (8.5).
-// Offsets that stay constant (a dock whose lights are not where its file says): 19.6 and 9.7,
-// and 5.8 with the floor's correlation time following too (max_window_vision_correlation_time_s
+// Offsets that stay constant (a dock whose lights are not where its file says): 19.6 and 9.5,
+// and 5.7 with the floor's correlation time following too (max_window_vision_correlation_time_s
 // 10 s).
 TEST(EstimatorConsistencyTest, SlidingWindowFloorFollowsPerLightBiasesNobodyConfigured) {
   test::SyntheticPixelNoise noise;

@@ -126,7 +126,6 @@ double FeedOnline(int frames, const std::function<std::vector<MonoLight>(int)>& 
                   const SlowVisionErrorOptions& options = {}) {
   Tracks tracks;
   SlowVisionError slow(options);
-  std::vector<VisionResidual> previous;
   for (int k = 0; k < frames; ++k) {
     const size_t first = tracks.residuals.size();
     const std::vector<MonoLight> lights = frame(k);
@@ -134,9 +133,9 @@ double FeedOnline(int frames, const std::function<std::vector<MonoLight>(int)>& 
       tracks.AddMono(static_cast<int>(i), {lights[i].error_px}, lights[i].sigma_px);
       tracks.residuals.back().t_ns = k * kFrameNs;
     }
-    std::vector<VisionResidual> newest(tracks.residuals.begin() + first, tracks.residuals.end());
-    slow.Add(tracks.problem, previous, previous, newest, 3 * kFrameNs / 2);
-    previous = newest;
+    const std::vector<VisionResidual> newest(tracks.residuals.begin() + first,
+                                             tracks.residuals.end());
+    slow.Add(tracks.problem, newest, 3 * kFrameNs / 2);
   }
   return slow.slow_px();
 }

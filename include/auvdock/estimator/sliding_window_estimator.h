@@ -210,10 +210,10 @@ struct EstimatorOptions {
   // default scenario whose lights carry view-dependent biases of 0.15-0.3 px gave a mean NEES of
   // 9.1-15.8 at the fixed 0.05 px, 4.0-5.7 with the floor following (docs/light_detectors.md).
   // Once the floor is raised, its correlation time may follow too: from the decay of the lag
-  // products between the newest state and the previous one and between the newest and the
-  // oldest, at least the configured one and at most max_window_vision_correlation_time_s (by
-  // default the configured 1 s: off). Constant per-light offsets (a dock whose lights are not
-  // where its file says) do not decay; there it helps (synthetic, vision only: NEES 9.7 -> 5.8
+  // products between consecutive frames and frames 9 apart, at least the configured one and at
+  // most max_window_vision_correlation_time_s (by default the configured 1 s: off). Constant
+  // per-light offsets (a dock whose lights are not where its file says) do not decay; there it
+  // helps (synthetic, vision only: NEES 9.5 -> 5.7
   // at 10 s) but it cost accuracy where the offsets turn with the view (biases of 0.3-0.6 px:
   // 15.6 -> 18.2 mm before the projection), so it is the user's choice; summary.json shows the
   // floor and the time in use.

@@ -26,19 +26,28 @@
 // Units: px. Only finite residuals of tracks with consecutive frames (gap <= max_gap_ns) count.
 //
 // SlowVisionError is the same C1 for the sliding window, online: after each solve it pairs the
-// residuals of the newest state with those of the previous one (the same light in the same
-// camera system, both at the current solution) and keeps an exponential moving average of the
-// information-weighted lag products over time_constant_frames frames. Each product is divided
-// by the share of an offset a pose leaves in the residuals, 1 - 6 / n for a frame of n
-// coordinates (least squares with 6 parameters), so that sqrt(C1) estimates the slow error
-// rather than what is left of it. The window takes it as its floor (window_vision_floor_px)
+// residuals of the newest state with those of the previous frame (the same light in the same
+// camera system) and keeps an exponential moving average of the information-weighted lag
+// products over time_constant_frames frames. Each state's residuals
+// are taken right after its own solve, with the part a change of its pose could explain taken
+// out (a projection on the pose Jacobians: what another sensor pulls the pose to moves every
+// light as a pose change does), and each product is divided by the share of an offset such a
+// fit leaves, 1 - 6 / n for n coordinates, so that sqrt(C1) estimates the slow error rather
+// than what is left of it. The window takes it as its floor (window_vision_floor_px)
 // when it is larger than the configured one, so that the allowance for slow errors follows
-// views whose biases nobody configured. Pairs with the oldest state (a lag of the window's
-// span) give the slow part's decay, and so its correlation time.
+// views whose biases nobody configured. Pairs with the frame far_lag_frames before (a default
+// window's span) give the slow part's decay, and so its correlation time. Each frame's
+// residuals are evaluated once, when it is the newest.
 #pragma once
 
 #include <cstdint>
+#include <deque>
+#include <map>
+#include <string>
+#include <tuple>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include <ceres/problem.h>
 
@@ -63,18 +72,26 @@ struct SlowVisionErrorOptions {
   double time_constant_frames = 200.0;  // frames with pairs (20 s at 10 Hz), each weighted by
                                         // its information against the frames' mean
   double min_pairs = 200.0;             // coordinate pairs seen before slow_px() is other than 0
+  int far_lag_frames = 9;               // the second lag, in frames (a default window's span)
 };
+
+// One residual as a pixel-equivalent error (whitened residual x its pixel sigma).
+struct VisionErrorSample {
+  int64_t t_ns = 0;
+  Eigen::Vector3d e = Eigen::Vector3d::Zero();  // px (a mono residual's third entry 0)
+  double sigma = 1.0;                           // its pixel sigma
+  int m = 2;                                    // 2 (mono) or 3 (stereo)
+};
+using VisionTrackKey = std::tuple<bool, std::string, int>;  // (mono, camera, light id)
 
 class SlowVisionError {
  public:
   explicit SlowVisionError(const SlowVisionErrorOptions& options = {}) : options_(options) {}
 
-  // The vision residuals of the window's oldest, previous and newest states, still in the
-  // problem: the newest against the previous gives C1 (pairs further apart than max_gap_ns are
-  // not counted), against the oldest C_L, a lag of the window's span; pass `previous` as
-  // `oldest` when the window holds two states.
-  void Add(const ceres::Problem& problem, const std::vector<VisionResidual>& oldest,
-           const std::vector<VisionResidual>& previous, const std::vector<VisionResidual>& newest,
+  // The newest state's vision residuals, still in the problem, right after its solve. They are
+  // paired with the previous frame's (C1; pairs further apart than max_gap_ns are not counted)
+  // and with those of far_lag_frames frames before (C_L).
+  void Add(const ceres::Problem& problem, const std::vector<VisionResidual>& newest,
            int64_t max_gap_ns);
 
   // sqrt(max(0, C1)) once min_pairs coordinate pairs were seen; 0 before, or when disabled.
@@ -86,8 +103,9 @@ class SlowVisionError {
   double pairs_seen() const { return near_.pairs_seen; }
 
  private:
-  struct LagProductsView {
-    double sum, weight, pairs, lag_s;
+  struct FrameSamples {
+    std::map<VisionTrackKey, VisionErrorSample> samples;
+    double kept_share = 1.0;  // the share of an offset the pose fit left in them
   };
   struct Moments {
     double mean_product = 0.0;  // EMA of the weighted lag products per weight (px^2)
@@ -95,11 +113,14 @@ class SlowVisionError {
     double mean_lag_s = 0.0;    // EMA of the pairs' time lag (s)
     double pairs_seen = 0.0;
     double frames_seen = 0.0;
-    void Blend(const LagProductsView& frame, double time_constant_frames);
+    // Blends in the lag products between two frames' samples.
+    void Blend(const FrameSamples& earlier, const FrameSamples& later, int64_t max_gap_ns,
+               double time_constant_frames);
   };
   SlowVisionErrorOptions options_;
+  std::deque<FrameSamples> history_;  // the last far_lag_frames frames, oldest first
   Moments near_;  // newest against previous
-  Moments far_;   // newest against oldest
+  Moments far_;   // newest against far_lag_frames before
 };
 
 }  // namespace auvdock
